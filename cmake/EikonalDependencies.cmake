@@ -1,0 +1,20 @@
+# All third-party dependencies come from Debian packages (scripts/setup.sh installs them).
+find_package(PkgConfig REQUIRED)
+find_package(Threads REQUIRED)
+find_package(ZLIB REQUIRED)
+find_package(glm REQUIRED)
+find_package(nlohmann_json 3.10 REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(TinyGLTF REQUIRED)   # a compiled library on Debian: never define TINYGLTF_IMPLEMENTATION
+find_package(glfw3 3.3 REQUIRED)
+pkg_check_modules(OSMESA REQUIRED IMPORTED_TARGET osmesa)
+pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)
+# OpenImageIO through pkg-config: its CMake config names a non-existent /usr/include/opencv4 (DESIGN §3).
+pkg_check_modules(OIIO REQUIRED IMPORTED_TARGET OpenImageIO)
+if(EIKONAL_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()
+if(EIKONAL_BUILD_BENCHMARKS)
+  find_package(benchmark QUIET)
+endif()
+find_program(GLAD_EXECUTABLE glad REQUIRED)   # python3-glad 2.x

@@ -1,0 +1,136 @@
+#include "core/atomic_file.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <random>
+#include <string>
+#include <system_error>
+#include <utility>
+
+#include "core/error.h"
+
+namespace eik {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string randomSuffix() {
+  // A per-process random seed plus a counter: unique across threads and concurrent processes.
+  static const std::uint64_t seed = [] {
+    std::random_device device;
+    return (static_cast<std::uint64_t>(device()) << 32) ^ device();
+  }();
+  static std::atomic<std::uint64_t> counter{0};
+  std::uint64_t value = seed + 0x9E3779B97F4A7C15ull * ++counter;
+  value ^= value >> 29;
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(value));
+  return text;
+}
+
+fs::path directoryOf(const fs::path& target) {
+  fs::path dir = target.parent_path();
+  return dir.empty() ? fs::path(".") : dir;
+}
+
+}  // namespace
+
+fs::path temporaryPathFor(const fs::path& target) {
+  std::string name = "." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
+                     randomSuffix();
+  return target.parent_path() / name;
+}
+
+AtomicFileSet::~AtomicFileSet() { discard(); }
+
+AtomicFileSet::AtomicFileSet(AtomicFileSet&& other) noexcept
+    : entries_(std::move(other.entries_)), committed_(other.committed_) {
+  other.entries_.clear();
+}
+
+AtomicFileSet& AtomicFileSet::operator=(AtomicFileSet&& other) noexcept {
+  if (this != &other) {
+    discard();
+    entries_ = std::move(other.entries_);
+    committed_ = other.committed_;
+    other.entries_.clear();
+  }
+  return *this;
+}
+
+fs::path AtomicFileSet::stage(const fs::path& target) {
+  if (committed_) throw RuntimeError(target.string() + ": cannot stage a file in a committed AtomicFileSet");
+  if (target.filename().empty()) throw InputError(target.string(), "", "not a file name");
+  for (const Entry& entry : entries_) {
+    if (entry.target == target) throw RuntimeError(target.string() + ": staged twice for one atomic write");
+  }
+  std::error_code ec;
+  fs::path dir = directoryOf(target);
+  if (!fs::is_directory(dir, ec)) {
+    throw InputError(target.string(), "", "output directory " + dir.string() + " does not exist");
+  }
+  if (fs::is_directory(target, ec)) throw InputError(target.string(), "", "is a directory");
+  entries_.push_back({target, temporaryPathFor(target)});
+  return entries_.back().temporary;
+}
+
+void AtomicFileSet::write(const fs::path& target, std::string_view bytes) {
+  fs::path temporary = stage(target);
+  struct FileCloser {
+    void operator()(std::FILE* f) const { std::fclose(f); }
+  };
+  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(temporary.c_str(), "wb"));
+  if (!file) throw RuntimeError(target.string() + ": cannot create file: " + std::strerror(errno));
+  if (!bytes.empty() && std::fwrite(bytes.data(), 1, bytes.size(), file.get()) != bytes.size()) {
+    throw RuntimeError(target.string() + ": write failed: " + std::strerror(errno));
+  }
+  if (std::fclose(file.release()) != 0) {
+    throw RuntimeError(target.string() + ": write failed: " + std::strerror(errno));
+  }
+}
+
+void AtomicFileSet::commit() {
+  if (committed_) return;
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    std::error_code ec;
+    fs::rename(entries_[i].temporary, entries_[i].target, ec);
+    if (ec) {
+      std::string message = entries_[i].target.string() + ": cannot move the finished file into place: " +
+                            ec.message();
+      // Files before i are in place already; drop the rest so no temporaries are left behind.
+      entries_.erase(entries_.begin(), entries_.begin() + static_cast<std::ptrdiff_t>(i));
+      discard();
+      throw RuntimeError(message);
+    }
+  }
+  entries_.clear();
+  committed_ = true;
+}
+
+void AtomicFileSet::discard() noexcept {
+  for (const Entry& entry : entries_) {
+    std::error_code ec;
+    fs::remove(entry.temporary, ec);  // the file may never have been created: ignore errors
+  }
+  entries_.clear();
+}
+
+std::vector<fs::path> AtomicFileSet::targets() const {
+  std::vector<fs::path> result;
+  result.reserve(entries_.size());
+  for (const Entry& entry : entries_) result.push_back(entry.target);
+  return result;
+}
+
+void writeFileAtomic(const fs::path& path, std::string_view bytes) {
+  AtomicFileSet files;
+  files.write(path, bytes);
+  files.commit();
+}
+
+}  // namespace eik

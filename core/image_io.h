@@ -1,0 +1,36 @@
+// Images in and out through OpenImageIO: renders as EXR (linear, untone-mapped float) or PNG
+// (tone-mapped 8-bit sRGB), environment maps in (EXR, HDR, PNG, ...). Writes are atomic.
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+#include "core/tonemap.h"
+
+namespace eik {
+
+// Linear RGBA float pixels, rows top to bottom.
+struct Image {
+  int width = 0;
+  int height = 0;
+  int channels = 4;
+  std::vector<float> pixels;
+
+  float* at(int x, int y) { return pixels.data() + (static_cast<std::size_t>(y) * width + x) * channels; }
+  const float* at(int x, int y) const { return pixels.data() + (static_cast<std::size_t>(y) * width + x) * channels; }
+};
+
+struct ImageWriteOptions {
+  float exposure_ev = 0.0f;        // PNG only
+  ToneMapper tonemap = ToneMapper::Aces;  // PNG only
+};
+
+// By extension: .exr writes linear half-float RGB(A) as rendered; .png (also .jpg, .tif) writes
+// tone-mapped sRGB 8-bit. InputError for an unknown extension, RuntimeError when writing fails.
+void writeImage(const std::filesystem::path& path, const Image& image, const ImageWriteOptions& options = {});
+
+// Reads any format OpenImageIO knows as linear float RGB(A) (sRGB-encoded 8-bit files are
+// linearised). InputError naming the file when it cannot be read.
+Image readImage(const std::filesystem::path& path);
+
+}  // namespace eik

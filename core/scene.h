@@ -1,0 +1,83 @@
+// SCENE.json: volumes placed in a world, with lights, camera, environment, ground and render
+// settings (DESIGN §4.3). Read strictly: wrong types and unknown keys are InputErrors (exit 2).
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+namespace eik {
+
+struct SceneCameraSpec {
+  glm::dvec3 eye{0.0, 4.0, 6.0};
+  glm::dvec3 target{0.0, 0.8, 0.0};
+  glm::dvec3 up{0.0, 1.0, 0.0};
+  double fov_y_deg = 40.0;
+};
+
+struct SceneLightSpec {
+  enum class Type { Directional, Point };
+  Type type = Type::Directional;
+  glm::dvec3 direction{0.0, -1.0, 0.0};   // directional: direction the light travels (unit)
+  glm::dvec3 irradiance{1.0};             // directional: W/m² on a plane facing the light, RGB
+  glm::dvec3 position{0.0};               // point
+  glm::dvec3 intensity{1.0};              // point: radiant intensity W/sr, RGB
+};
+
+struct SceneEnvironmentSpec {
+  std::optional<glm::dvec3> uniform = glm::dvec3(0.1);   // uniform radiance, or
+  std::string file;                                      // an equirectangular map (path as written)
+  double intensity = 1.0;
+  double rotate_deg = 0.0;
+  std::string procedural;                                // e.g. "sky" (viewer issue)
+};
+
+struct SceneGroundSpec {
+  glm::dvec3 point{0.0};
+  glm::dvec3 normal{0.0, 1.0, 0.0};
+  glm::dvec3 albedo{0.8};
+  double half_extent = 4.0;
+};
+
+struct SceneObjectSpec {
+  std::string volume;                  // path as written in the file (relative to the scene file)
+  glm::dvec3 translate{0.0};
+  glm::dvec3 rotate_deg{0.0};          // XYZ Euler angles in degrees, applied X then Y then Z
+  double scale = 1.0;
+};
+
+struct SceneRenderSpec {
+  glm::ivec2 size{256, 256};
+  double step_voxels = 0.5;
+  double exposure = 0.0;               // EV
+  std::string tonemap = "aces";        // aces | reinhard | linear
+};
+
+struct Scene {
+  SceneCameraSpec camera;
+  SceneEnvironmentSpec environment;
+  std::vector<SceneLightSpec> lights;
+  std::optional<SceneGroundSpec> ground;
+  std::vector<SceneObjectSpec> objects;
+  SceneRenderSpec render;
+  std::filesystem::path base_dir;      // directory the scene was read from (for relative paths)
+
+  // Absolute path of an object's volume or the environment file.
+  std::filesystem::path resolve(const std::string& relative) const;
+};
+
+// Parses and validates; `source` names the file in messages ("scene.json: lights[0].direction: ...").
+Scene sceneFromJson(const nlohmann::json& j, const std::string& source);
+Scene readScene(const std::filesystem::path& file);
+nlohmann::json sceneToJson(const Scene& scene);
+void writeScene(const Scene& scene, const std::filesystem::path& file);
+
+// Photometric to radiometric conversion used for glTF lights (KHR_lights_punctual): directional
+// intensity is in lux and point intensity in candela; 683 lm/W (Blender writes 683 lux for 1 W/m²).
+constexpr double kLumensPerWatt = 683.0;
+
+}  // namespace eik

@@ -1,0 +1,433 @@
+// Volumes on disk (DESIGN §4.1): a JSON manifest `NAME.vol.json` and one NRRD per field beside it,
+// `NAME.FIELD.nrrd` (or `NAME.FIELD.nhdr` + `NAME.FIELD.raw.gz` when detached), written atomically.
+#include "core/volume.h"
+
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <system_error>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/limits.h"
+#include "core/nrrd.h"
+
+namespace eik {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::string_view kFormat = "eikonal-volume";
+constexpr int kVersion = 1;
+// Manifest keys writeVolume owns; metadata cannot overwrite them.
+constexpr std::string_view kReservedKeys[] = {"format", "version", "dims", "bounds_min", "bounds_max", "fields"};
+
+bool isReserved(std::string_view key) {
+  for (std::string_view reserved : kReservedKeys) {
+    if (key == reserved) return true;
+  }
+  return false;
+}
+
+std::string formatTriple(const glm::dvec3& v) {
+  char text[96];
+  std::snprintf(text, sizeof text, "%.9g %.9g %.9g", v.x, v.y, v.z);
+  return text;
+}
+
+std::string formatTriple(const glm::ivec3& v) {
+  return std::to_string(v.x) + " " + std::to_string(v.y) + " " + std::to_string(v.z);
+}
+
+// "NAME" for "DIR/NAME.vol.json" (or "DIR/NAME.json", or any other "DIR/NAME").
+std::string manifestStem(const fs::path& manifest) {
+  std::string name = manifest.filename().string();
+  for (std::string_view suffix : {std::string_view(".vol.json"), std::string_view(".json")}) {
+    if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+      return name.substr(0, name.size() - suffix.size());
+    }
+  }
+  return name;
+}
+
+bool isValidFieldName(const std::string& name) {
+  if (name.empty()) return false;
+  for (char c : name) {
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) return false;
+  }
+  return true;
+}
+
+NrrdHeader nrrdHeaderFor(const GridSpec& grid, int components) {
+  NrrdHeader header;
+  header.components = components;
+  header.sizes = grid.dims;
+  glm::dvec3 h = grid.voxelSize();
+  header.origin = grid.bounds_min + 0.5 * h;  // NRRD space origin = centre of voxel 0 (core/grid.h)
+  header.directions = glm::dmat3(h.x, 0, 0, 0, h.y, 0, 0, 0, h.z);
+  return header;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Manifest parsing
+
+class ManifestReader {
+ public:
+  explicit ManifestReader(const fs::path& manifest) : manifest_(manifest), name_(manifest.string()) {}
+
+  Volume read(bool with_data) {
+    nlohmann::json root = parse();
+    Volume volume;
+    checkFormat(root);
+    volume.grid.dims = dims(root);
+    volume.grid.bounds_min = numberTriple(root, "bounds_min");
+    volume.grid.bounds_max = numberTriple(root, "bounds_max");
+    for (int a = 0; a < 3; ++a) {
+      if (!(volume.grid.bounds_min[a] < volume.grid.bounds_max[a])) {
+        throw InputError(name_, "bounds_max",
+                         "must be greater than bounds_min on every axis (" + std::string(1, "xyz"[a]) + ": " +
+                             formatTriple(volume.grid.bounds_min) + " vs " + formatTriple(volume.grid.bounds_max) +
+                             ")");
+      }
+    }
+
+    auto fields = root.find("fields");
+    if (fields == root.end()) throw InputError(name_, "fields", "missing (the table of field files)");
+    if (!fields->is_object()) throw InputError(name_, "fields", "expected an object {\"NAME\": {\"file\": ...}}");
+
+    // Headers first: every field is validated, and the total checked against memory, before any data is read.
+    struct Entry {
+      std::string name;
+      fs::path file;
+      NrrdHeader header;
+    };
+    std::vector<Entry> entries;
+    std::uint64_t total_bytes = 0;
+    for (const auto& [name, spec] : fields->items()) {
+      Entry entry{name, fieldFile(name, spec), {}};
+      entry.header = fieldHeader(name, spec, entry.file, volume.grid);
+      total_bytes += fieldBytes(entry.header.sizes, entry.header.components);
+      entries.push_back(std::move(entry));
+    }
+    checkMemoryLimit(name_, "fields", total_bytes);
+
+    for (Entry& entry : entries) {
+      Field& field = volume.fields[entry.name];
+      field.components = entry.header.components;
+      if (with_data) {
+        try {
+          field.data = readNrrd(entry.file).data;
+        } catch (const InputError& e) {
+          throw InputError(name_ + ": fields." + entry.name + ": " + e.what());
+        }
+      }
+    }
+
+    for (const auto& [key, value] : root.items()) {
+      if (!isReserved(key)) volume.metadata[key] = value;
+    }
+    return volume;
+  }
+
+ private:
+  nlohmann::json parse() {
+    std::error_code ec;
+    if (fs::is_directory(manifest_, ec)) throw InputError(name_, "", "is a directory, not a volume manifest");
+    std::ifstream in(manifest_, std::ios::binary);
+    if (!in) throw InputError(name_, "", std::string("cannot open: ") + std::strerror(errno));
+    std::ostringstream text;
+    text << in.rdbuf();
+    nlohmann::json root;
+    try {
+      root = nlohmann::json::parse(text.str());
+    } catch (const nlohmann::json::parse_error& e) {
+      // "[json.exception.parse_error.101] parse error at line 3, column 5: ..." without the tag.
+      std::string what = e.what();
+      std::size_t tag_end = what.find("] ");
+      if (what.rfind("[json.exception", 0) == 0 && tag_end != std::string::npos) what = what.substr(tag_end + 2);
+      throw InputError(name_, "JSON", what);
+    }
+    if (!root.is_object()) throw InputError(name_, "JSON", "expected an object at the top level");
+    return root;
+  }
+
+  void checkFormat(const nlohmann::json& root) {
+    auto format = root.find("format");
+    if (format == root.end()) {
+      throw InputError(name_, "format", "missing (expected \"" + std::string(kFormat) + "\")");
+    }
+    if (!format->is_string() || format->get<std::string>() != kFormat) {
+      throw InputError(name_, "format", format->dump() + " is not \"" + std::string(kFormat) + "\"");
+    }
+    auto version = root.find("version");
+    if (version != root.end()) {
+      if (!version->is_number_integer()) throw InputError(name_, "version", version->dump() + " is not an integer");
+      long long v = version->get<long long>();
+      if (v < 1 || v > kVersion) {
+        throw InputError(name_, "version",
+                         std::to_string(v) + " is not supported (this program reads version " +
+                             std::to_string(kVersion) + ")");
+      }
+    }
+  }
+
+  const nlohmann::json& requireTriple(const nlohmann::json& root, const char* key) {
+    auto it = root.find(key);
+    if (it == root.end()) throw InputError(name_, key, "missing (expected an array of 3 numbers)");
+    if (!it->is_array() || it->size() != 3) {
+      throw InputError(name_, key, it->dump() + " is not an array of 3 numbers");
+    }
+    return *it;
+  }
+
+  glm::ivec3 dims(const nlohmann::json& root) {
+    const nlohmann::json& array = requireTriple(root, "dims");
+    glm::ivec3 dims;
+    for (int a = 0; a < 3; ++a) {
+      const nlohmann::json& item = array[static_cast<std::size_t>(a)];
+      if (!item.is_number_integer()) throw InputError(name_, "dims", item.dump() + " is not an integer");
+      long long value = item.get<long long>();
+      if (value <= 0) throw InputError(name_, "dims", std::to_string(value) + " is not positive");
+      if (value > kMaxVolumeAxis) {
+        throw InputError(name_, "dims",
+                         std::to_string(value) + " voxels along " + "xyz"[a] + " exceeds the limit of " +
+                             std::to_string(kMaxVolumeAxis) + " voxels per axis");
+      }
+      dims[a] = static_cast<int>(value);
+    }
+    return dims;
+  }
+
+  glm::dvec3 numberTriple(const nlohmann::json& root, const char* key) {
+    const nlohmann::json& array = requireTriple(root, key);
+    glm::dvec3 result;
+    for (int a = 0; a < 3; ++a) {
+      const nlohmann::json& item = array[static_cast<std::size_t>(a)];
+      if (!item.is_number()) throw InputError(name_, key, item.dump() + " is not a number");
+      result[a] = item.get<double>();
+      if (!std::isfinite(result[a])) throw InputError(name_, key, item.dump() + " is not finite");
+    }
+    return result;
+  }
+
+  fs::path fieldFile(const std::string& name, const nlohmann::json& spec) {
+    const std::string key = "fields." + name;
+    if (!spec.is_object()) throw InputError(name_, key, "expected an object {\"file\": ..., \"components\": N}");
+    auto file = spec.find("file");
+    if (file == spec.end()) throw InputError(name_, key + ".file", "missing (the field's NRRD file)");
+    if (!file->is_string() || file->get<std::string>().empty()) {
+      throw InputError(name_, key + ".file", file->dump() + " is not a file name");
+    }
+    fs::path path(file->get<std::string>());
+    if (path.is_relative()) path = manifest_.parent_path() / path;  // relative to the manifest
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) throw InputError(name_, key + ".file", path.string() + ": not found");
+    return path;
+  }
+
+  NrrdHeader fieldHeader(const std::string& name, const nlohmann::json& spec, const fs::path& file,
+                         const GridSpec& grid) {
+    const std::string key = "fields." + name;
+    const int known = knownFieldComponents(name);
+    int declared = 0;
+    auto components = spec.find("components");
+    if (components != spec.end()) {
+      if (!components->is_number_integer()) {
+        throw InputError(name_, key + ".components", components->dump() + " is not an integer");
+      }
+      long long value = components->get<long long>();
+      if (value < 1 || value > 4) {
+        throw InputError(name_, key + ".components", std::to_string(value) + " is not in 1..4");
+      }
+      declared = static_cast<int>(value);
+      if (known != 0 && declared != known) {
+        throw InputError(name_, key + ".components",
+                         std::to_string(declared) + ", but the '" + name + "' field has " + std::to_string(known) +
+                             " components (DESIGN section 4.1)");
+      }
+    }
+
+    NrrdHeader header;
+    try {
+      header = readNrrdHeader(file);
+    } catch (const InputError& e) {
+      throw InputError(name_ + ": " + key + ": " + e.what());
+    }
+    const std::string nrrd = file.string();
+    if (declared != 0 && header.components != declared) {
+      throw InputError(name_, key + ".components",
+                       std::to_string(declared) + ", but " + nrrd + " has " + std::to_string(header.components) +
+                           " components");
+    }
+    if (known != 0 && header.components != known) {
+      throw InputError(name_, key,
+                       nrrd + " has " + std::to_string(header.components) + " components, but the '" + name +
+                           "' field has " + std::to_string(known) + " (DESIGN section 4.1)");
+    }
+    if (header.sizes != grid.dims) {
+      throw InputError(name_, key,
+                       nrrd + ": sizes " + formatTriple(header.sizes) + " do not match the manifest's dims " +
+                           formatTriple(grid.dims));
+    }
+    checkGeometry(key, nrrd, header, grid);
+    return header;
+  }
+
+  // The NRRD must sit where the manifest says (relative tolerance 1e-4): origin = bounds_min + h/2,
+  // directions = diag(h).
+  void checkGeometry(const std::string& key, const std::string& nrrd, const NrrdHeader& header,
+                     const GridSpec& grid) {
+    const NrrdHeader expected = nrrdHeaderFor(grid, header.components);
+    const glm::dvec3 h = grid.voxelSize();
+    const double h_max = std::max(h.x, std::max(h.y, h.z));
+    constexpr double kTolerance = 1e-4;
+    for (int a = 0; a < 3; ++a) {
+      double scale = std::max(std::abs(expected.origin[a]), h[a]);
+      if (std::abs(header.origin[a] - expected.origin[a]) > kTolerance * scale) {
+        throw InputError(name_, key,
+                         nrrd + ": space origin " + formatTriple(header.origin) +
+                             " does not match the manifest's bounds_min + half a voxel " +
+                             formatTriple(expected.origin));
+      }
+      for (int b = 0; b < 3; ++b) {
+        double tolerance = kTolerance * (a == b ? h[a] : h_max);
+        if (std::abs(header.directions[a][b] - expected.directions[a][b]) > tolerance) {
+          throw InputError(name_, key,
+                           nrrd + ": space directions (axis " + std::to_string(a) + ": " +
+                               formatTriple(header.directions[a]) + ") do not match the manifest's voxel size " +
+                               formatTriple(h) + " (an axis-aligned grid from bounds_min to bounds_max)");
+        }
+      }
+    }
+  }
+
+  fs::path manifest_;
+  std::string name_;
+};
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+const std::vector<FieldSpec>& knownFields() {
+  static const std::vector<FieldSpec> fields = {
+      {"ior", 1, "refractive index n after pre-smoothing (1 = vacuum/air)"},
+      {"ior_grad", 3, "gradient of n in 1/world-unit (central differences of the smoothed n)"},
+      {"sigma_a", 3, "RGB absorption (attenuation) coefficient"},
+      {"emission", 3, "RGB emitted radiance L_e"},
+      {"scatter", 2, "albedo (scatter strength) and Henyey-Greenstein g"},
+      {"opaque", 4, "RGB diffuse albedo of an opaque embedding/receiver, and its indicator"},
+      {"reflect", 4, "RGB reflection tint and weight at boundaries"},
+      {"dispersion", 1, "Cauchy B (um^2): n(lambda) = n + B (1/lambda^2 - 1/lambda_d^2)"},
+      {"irradiance", 3, "baked RGB irradiance (from lightsim)"},
+      {"light_dir", 3, "baked unit local light direction (from lightsim)"},
+  };
+  return fields;
+}
+
+int knownFieldComponents(std::string_view name) {
+  for (const FieldSpec& spec : knownFields()) {
+    if (spec.name == name) return spec.components;
+  }
+  return 0;
+}
+
+Field& Volume::addField(const std::string& name, int components) {
+  if (components < 1 || components > 4) {
+    throw RuntimeError("fields." + name + ": " + std::to_string(components) + " components (expected 1 to 4)");
+  }
+  int known = knownFieldComponents(name);
+  if (known != 0 && known != components) {
+    throw RuntimeError("fields." + name + ": " + std::to_string(components) + " components, but the '" + name +
+                       "' field has " + std::to_string(known) + " (DESIGN section 4.1)");
+  }
+  Field& field = fields[name];
+  field.components = components;
+  field.data.assign(grid.count() * static_cast<std::size_t>(components), 0.0f);
+  return field;
+}
+
+const Field* Volume::find(const std::string& name) const {
+  auto it = fields.find(name);
+  return it == fields.end() ? nullptr : &it->second;
+}
+
+const Field& Volume::require(const std::string& name, int components, const std::string& source) const {
+  const Field* field = find(name);
+  if (!field) {
+    std::string present;
+    for (const auto& [other, unused] : fields) present += (present.empty() ? "" : ", ") + other;
+    throw InputError(source, "fields." + name,
+                     "missing (the volume has " + (present.empty() ? std::string("no fields") : present) + ")");
+  }
+  if (components > 0 && field->components != components) {
+    throw InputError(source, "fields." + name,
+                     "has " + std::to_string(field->components) + " components, expected " +
+                         std::to_string(components));
+  }
+  return *field;
+}
+
+Volume readVolume(const fs::path& manifest) { return ManifestReader(manifest).read(true); }
+
+Volume readVolumeHeader(const fs::path& manifest) { return ManifestReader(manifest).read(false); }
+
+void writeVolume(const Volume& volume, const fs::path& manifest, const VolumeWriteOptions& options) {
+  const std::string name = manifest.string();
+  const GridSpec& grid = volume.grid;
+  for (int a = 0; a < 3; ++a) {
+    if (grid.dims[a] < 1 || grid.dims[a] > kMaxVolumeAxis) {
+      throw RuntimeError(name + ": dims: " + formatTriple(grid.dims) + " (each must be 1 to " +
+                         std::to_string(kMaxVolumeAxis) + ")");
+    }
+    if (!(grid.bounds_min[a] < grid.bounds_max[a]) || !std::isfinite(grid.bounds_min[a]) ||
+        !std::isfinite(grid.bounds_max[a])) {
+      throw RuntimeError(name + ": bounds: " + formatTriple(grid.bounds_min) + " to " +
+                         formatTriple(grid.bounds_max) + " is not a finite box with bounds_min < bounds_max");
+    }
+  }
+  if (!volume.metadata.is_null() && !volume.metadata.is_object()) {
+    throw RuntimeError(name + ": metadata must be a JSON object");
+  }
+
+  const std::string stem = manifestStem(manifest);
+  const fs::path dir = manifest.parent_path();
+  AtomicFileSet files;  // removes every temporary if anything below throws
+
+  nlohmann::ordered_json table = nlohmann::ordered_json::object();
+  for (const auto& [field_name, field] : volume.fields) {
+    if (!isValidFieldName(field_name)) {
+      throw RuntimeError(name + ": fields." + field_name + ": a field name may hold only letters, digits, '_' and '-'");
+    }
+    int known = knownFieldComponents(field_name);
+    if (known != 0 && known != field.components) {
+      throw RuntimeError(name + ": fields." + field_name + ": " + std::to_string(field.components) +
+                         " components, but the '" + field_name + "' field has " + std::to_string(known) +
+                         " (DESIGN section 4.1)");
+    }
+    fs::path file = dir / (stem + "." + field_name + (options.detached ? ".nhdr" : ".nrrd"));
+    stageNrrd(files, file, nrrdHeaderFor(grid, field.components), field.data, {options.gzip, options.detached});
+    table[field_name] = {{"file", file.filename().string()}, {"components", field.components}};
+  }
+
+  nlohmann::ordered_json json = nlohmann::ordered_json::object();
+  json["format"] = kFormat;
+  json["version"] = kVersion;
+  json["dims"] = {grid.dims.x, grid.dims.y, grid.dims.z};
+  json["bounds_min"] = {grid.bounds_min.x, grid.bounds_min.y, grid.bounds_min.z};
+  json["bounds_max"] = {grid.bounds_max.x, grid.bounds_max.y, grid.bounds_max.z};
+  json["fields"] = std::move(table);
+  if (volume.metadata.is_object()) {
+    for (const auto& [key, value] : volume.metadata.items()) {
+      if (!isReserved(key)) json[key] = nlohmann::ordered_json::parse(value.dump());
+    }
+  }
+  files.write(manifest, json.dump(2) + "\n");  // staged last: renamed into place after every field
+  files.commit();
+}
+
+}  // namespace eik

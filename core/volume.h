@@ -1,0 +1,71 @@
+// A material volume: named float fields on one grid, stored on disk as a JSON manifest
+// (`*.vol.json`) naming one NRRD file per field (DESIGN §4.1, thesis §6.1 textures T1–T8).
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/grid.h"
+
+namespace eik {
+
+// The fields DESIGN §4.1 defines, with their component counts. Other names are allowed
+// (written and read like any field) but programs only interpret these.
+struct FieldSpec {
+  std::string_view name;
+  int components;
+  std::string_view meaning;
+};
+const std::vector<FieldSpec>& knownFields();
+// Component count of a known field, or 0 for an unknown name.
+int knownFieldComponents(std::string_view name);
+
+// One field: `components` floats per voxel, interleaved, voxels x fastest.
+struct Field {
+  int components = 1;
+  std::vector<float> data;
+
+  float* voxel(std::size_t index) { return data.data() + index * static_cast<std::size_t>(components); }
+  const float* voxel(std::size_t index) const {
+    return data.data() + index * static_cast<std::size_t>(components);
+  }
+};
+
+struct Volume {
+  GridSpec grid;
+  std::map<std::string, Field> fields;
+  // Further manifest entries carried through unchanged: "light", "bake_stats", "materials",
+  // "source", ... (everything but the reserved keys written by writeVolume).
+  nlohmann::json metadata = nlohmann::json::object();
+
+  // Adds (or replaces) a zero-filled field.
+  Field& addField(const std::string& name, int components);
+  bool has(const std::string& name) const { return fields.count(name) != 0; }
+  const Field* find(const std::string& name) const;
+  // The field, or an InputError naming `source` (the manifest) and the field.
+  const Field& require(const std::string& name, int components, const std::string& source = "volume") const;
+};
+
+struct VolumeWriteOptions {
+  bool gzip = true;         // NRRD encoding: gzip (default) or raw
+  bool detached = false;    // .nhdr + .raw(.gz) instead of attached .nrrd
+};
+
+// Reads a manifest and every field it names. Throws InputError (exit 2) naming the file and the
+// field for anything malformed (DESIGN §4.1, issue "Foundation" §3).
+Volume readVolume(const std::filesystem::path& manifest);
+// Reads only the manifest and the headers (grid, field table); no voxel data.
+Volume readVolumeHeader(const std::filesystem::path& manifest);
+
+// Writes `OUT.vol.json` and one NRRD per field beside it (`OUT.FIELD.nrrd`), atomically: all files
+// go to temporary names first and are renamed into place only when everything succeeded.
+void writeVolume(const Volume& volume, const std::filesystem::path& manifest,
+                 const VolumeWriteOptions& options = {});
+
+}  // namespace eik

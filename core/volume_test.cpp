@@ -1,0 +1,448 @@
+#include "core/volume.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "core/nrrd.h"
+
+namespace eik {
+namespace {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device random;
+    path_ = fs::temp_directory_path() / ("eikonal-volume-" + std::to_string(::getpid()) + "-" + std::to_string(random()));
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+  fs::path operator/(const std::string& name) const { return path_ / name; }
+  std::vector<std::string> entries() const {
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(path_)) names.push_back(entry.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+
+ private:
+  fs::path path_;
+};
+
+std::string slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+void spill(const fs::path& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out << bytes;
+}
+
+template <typename Body>
+std::string inputErrorOf(Body&& body) {
+  try {
+    body();
+  } catch (const InputError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected InputError, got: " << e.what();
+    return "";
+  }
+  ADD_FAILURE() << "expected InputError, nothing was thrown";
+  return "";
+}
+
+#define EXPECT_CONTAINS(text, part) \
+  EXPECT_NE(std::string(text).find(part), std::string::npos) << "message: " << (text) << "\nlacks: " << (part)
+
+Volume sampleVolume() {
+  Volume volume;
+  volume.grid.dims = {8, 6, 4};
+  volume.grid.bounds_min = {-1.0, -0.75, 0.1};
+  volume.grid.bounds_max = {1.0, 0.75, 0.9};
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> uniform(-2.0f, 2.0f);
+  for (auto [name, components] : {std::pair<const char*, int>{"ior", 1}, {"sigma_a", 3}, {"scatter", 2},
+                                  {"opaque", 4}, {"custom_mask", 1}}) {
+    Field& field = volume.addField(name, components);
+    for (float& v : field.data) v = uniform(random);
+  }
+  volume.metadata["light"] = {{"type", "directional"}, {"direction", {0, -1, 0}}};
+  volume.metadata["bake_stats"] = {{"patches", 12345}, {"seconds", 1.5}};
+  volume.metadata["format"] = "not-ours";  // reserved: must not overwrite the manifest's own key
+  return volume;
+}
+
+void expectSameVolume(const Volume& a, const Volume& b) {
+  EXPECT_EQ(a.grid, b.grid);
+  ASSERT_EQ(a.fields.size(), b.fields.size());
+  for (const auto& [name, field] : a.fields) {
+    const Field* other = b.find(name);
+    ASSERT_NE(other, nullptr) << name;
+    EXPECT_EQ(field.components, other->components) << name;
+    ASSERT_EQ(field.data.size(), other->data.size()) << name;
+    EXPECT_EQ(std::memcmp(field.data.data(), other->data.data(), field.data.size() * sizeof(float)), 0) << name;
+  }
+}
+
+// Writes the sample volume as DIR/scene.vol.json and returns the manifest's JSON for editing.
+json writeSample(const TempDir& dir, const VolumeWriteOptions& options = {}) {
+  writeVolume(sampleVolume(), dir / "scene.vol.json", options);
+  return json::parse(slurp(dir / "scene.vol.json"));
+}
+
+void rewriteManifest(const TempDir& dir, const json& manifest) { spill(dir / "scene.vol.json", manifest.dump(2)); }
+
+std::string manifestError(const TempDir& dir) {
+  return inputErrorOf([&] { readVolume(dir / "scene.vol.json"); });
+}
+
+// ---------------------------------------------------------------------------------------------
+
+TEST(Volume, KnownFieldsTable) {
+  EXPECT_EQ(knownFields().size(), 10u);
+  EXPECT_EQ(knownFieldComponents("ior"), 1);
+  EXPECT_EQ(knownFieldComponents("ior_grad"), 3);
+  EXPECT_EQ(knownFieldComponents("sigma_a"), 3);
+  EXPECT_EQ(knownFieldComponents("emission"), 3);
+  EXPECT_EQ(knownFieldComponents("scatter"), 2);
+  EXPECT_EQ(knownFieldComponents("opaque"), 4);
+  EXPECT_EQ(knownFieldComponents("reflect"), 4);
+  EXPECT_EQ(knownFieldComponents("dispersion"), 1);
+  EXPECT_EQ(knownFieldComponents("irradiance"), 3);
+  EXPECT_EQ(knownFieldComponents("light_dir"), 3);
+  EXPECT_EQ(knownFieldComponents("something_else"), 0);
+}
+
+TEST(Volume, AddFindRequire) {
+  Volume volume;
+  volume.grid.dims = {4, 3, 2};
+  Field& ior = volume.addField("ior", 1);
+  EXPECT_EQ(ior.data.size(), 24u);
+  EXPECT_TRUE(std::all_of(ior.data.begin(), ior.data.end(), [](float v) { return v == 0.0f; }));
+  EXPECT_EQ(volume.addField("sigma_a", 3).data.size(), 72u);
+  EXPECT_THROW(volume.addField("sigma_a", 1), RuntimeError);
+  EXPECT_TRUE(volume.has("ior"));
+  EXPECT_EQ(volume.find("emission"), nullptr);
+  EXPECT_EQ(&volume.require("ior", 1), &volume.fields.at("ior"));
+  EXPECT_EQ(&volume.require("sigma_a", 0), &volume.fields.at("sigma_a"));
+
+  std::string missing = inputErrorOf([&] { volume.require("irradiance", 3, "scene.vol.json"); });
+  EXPECT_CONTAINS(missing, "scene.vol.json: fields.irradiance: missing");
+  EXPECT_CONTAINS(missing, "ior, sigma_a");
+  std::string wrong = inputErrorOf([&] { volume.require("sigma_a", 4, "scene.vol.json"); });
+  EXPECT_CONTAINS(wrong, "scene.vol.json: fields.sigma_a: has 3 components, expected 4");
+}
+
+class VolumeRoundTrip : public ::testing::TestWithParam<VolumeWriteOptions> {};
+
+TEST_P(VolumeRoundTrip, IsBitExact) {
+  TempDir dir;
+  Volume volume = sampleVolume();
+  writeVolume(volume, dir / "scene.vol.json", GetParam());
+  Volume back = readVolume(dir / "scene.vol.json");
+  expectSameVolume(volume, back);
+  EXPECT_EQ(back.metadata.at("light"), volume.metadata.at("light"));
+  EXPECT_EQ(back.metadata.at("bake_stats"), volume.metadata.at("bake_stats"));
+  EXPECT_FALSE(back.metadata.contains("format"));
+  EXPECT_FALSE(back.metadata.contains("fields"));
+
+  // Every entry is a field file or the manifest: no temporaries.
+  std::vector<std::string> expected = {"scene.vol.json"};
+  for (const auto& [name, unused] : volume.fields) {
+    if (GetParam().detached) {
+      expected.push_back("scene." + name + ".nhdr");
+      expected.push_back("scene." + name + (GetParam().gzip ? ".raw.gz" : ".raw"));
+    } else {
+      expected.push_back("scene." + name + ".nrrd");
+    }
+  }
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(dir.entries(), expected);
+
+  // Writing the read-back volume again reproduces the manifest.
+  std::string first = slurp(dir / "scene.vol.json");
+  TempDir again;
+  writeVolume(back, again / "scene.vol.json", GetParam());
+  EXPECT_EQ(slurp(again / "scene.vol.json"), first);
+}
+
+INSTANTIATE_TEST_SUITE_P(Encodings, VolumeRoundTrip,
+                         ::testing::Values(VolumeWriteOptions{true, false}, VolumeWriteOptions{false, false},
+                                           VolumeWriteOptions{true, true}, VolumeWriteOptions{false, true}),
+                         [](const auto& info) {
+                           return std::string(info.param.gzip ? "gzip" : "raw") +
+                                  (info.param.detached ? "_detached" : "_attached");
+                         });
+
+TEST(Volume, ManifestLayout) {
+  TempDir dir;
+  json manifest = writeSample(dir);
+  EXPECT_EQ(manifest.at("format"), "eikonal-volume");
+  EXPECT_EQ(manifest.at("version"), 1);
+  EXPECT_EQ(manifest.at("dims"), json({8, 6, 4}));
+  EXPECT_EQ(manifest.at("bounds_min"), json({-1.0, -0.75, 0.1}));
+  EXPECT_EQ(manifest.at("bounds_max"), json({1.0, 0.75, 0.9}));
+  EXPECT_EQ(manifest.at("fields").at("ior"), json({{"file", "scene.ior.nrrd"}, {"components", 1}}));
+  EXPECT_EQ(manifest.at("fields").at("sigma_a"), json({{"file", "scene.sigma_a.nrrd"}, {"components", 3}}));
+  EXPECT_EQ(manifest.at("light").at("type"), "directional");
+  std::string text = slurp(dir / "scene.vol.json");
+  EXPECT_EQ(text.rfind("{\n  \"format\": \"eikonal-volume\",\n  \"version\": 1,", 0), 0u) << text;
+
+  // The NRRD sits on the grid: origin = centre of voxel 0, directions = diag(voxel size).
+  NrrdHeader header = readNrrdHeader(dir / "scene.sigma_a.nrrd");
+  EXPECT_EQ(header.components, 3);
+  EXPECT_EQ(header.sizes, glm::ivec3(8, 6, 4));
+  EXPECT_DOUBLE_EQ(header.origin.x, -1.0 + 0.125);
+  EXPECT_DOUBLE_EQ(header.origin.y, -0.75 + 0.125);
+  EXPECT_DOUBLE_EQ(header.origin.z, 0.1 + 0.1);
+  EXPECT_DOUBLE_EQ(header.directions[0][0], 0.25);
+  EXPECT_DOUBLE_EQ(header.directions[1][1], 0.25);
+  EXPECT_DOUBLE_EQ(header.directions[2][2], 0.2);
+  EXPECT_EQ(header.directions[0][1], 0.0);
+}
+
+TEST(Volume, HeaderOnlyReadSkipsTheData) {
+  TempDir dir;
+  writeSample(dir);
+  Volume volume = readVolumeHeader(dir / "scene.vol.json");
+  EXPECT_EQ(volume.grid.dims, glm::ivec3(8, 6, 4));
+  ASSERT_TRUE(volume.has("opaque"));
+  EXPECT_EQ(volume.fields.at("opaque").components, 4);
+  EXPECT_TRUE(volume.fields.at("opaque").data.empty());
+  EXPECT_EQ(volume.metadata.at("bake_stats").at("patches"), 12345);
+}
+
+TEST(Volume, ManifestNameWithoutVolJson) {
+  TempDir dir;
+  writeVolume(sampleVolume(), dir / "plain.json");
+  EXPECT_TRUE(fs::exists(dir / "plain.ior.nrrd"));
+  expectSameVolume(sampleVolume(), readVolume(dir / "plain.json"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Malformed manifests: every error names the manifest and the field.
+
+TEST(VolumeMalformed, MissingFieldFile) {
+  TempDir dir;
+  writeSample(dir);
+  fs::remove(dir / "scene.sigma_a.nrrd");
+  std::string message = manifestError(dir);
+  EXPECT_CONTAINS(message, (dir / "scene.vol.json").string() + ": fields.sigma_a.file: ");
+  EXPECT_CONTAINS(message, (dir / "scene.sigma_a.nrrd").string() + ": not found");
+  EXPECT_THROW(readVolumeHeader(dir / "scene.vol.json"), InputError);
+}
+
+TEST(VolumeMalformed, MissingDims) {
+  TempDir dir;
+  json manifest = writeSample(dir);
+  manifest.erase("dims");
+  rewriteManifest(dir, manifest);
+  EXPECT_CONTAINS(manifestError(dir), (dir / "scene.vol.json").string() + ": dims: missing");
+}
+
+TEST(VolumeMalformed, BadDims) {
+  TempDir dir;
+  json manifest = writeSample(dir);
+  for (json dims : {json({8, 6}), json({8, 6, 0}), json({8, 6, "4"}), json({8, 6, 2000}), json("8x6x4")}) {
+    manifest["dims"] = dims;
+    rewriteManifest(dir, manifest);
+    EXPECT_CONTAINS(manifestError(dir), (dir / "scene.vol.json").string() + ": dims: ");
+  }
+}
+
+TEST(VolumeMalformed, FieldWithWrongComponentCount) {
+  TempDir dir;
+  json manifest = writeSample(dir);
+  manifest["fields"]["sigma_a"]["components"] = 1;  // sigma_a is RGB
+  rewriteManifest(dir, manifest);
+  EXPECT_CONTAINS(manifestError(dir), "scene.vol.json: fields.sigma_a.components: 1, but the 'sigma_a' field has 3");
+
+  manifest = writeSample(dir);
+  manifest["fields"]["custom_mask"]["components"] = 2;  // the NRRD holds 1
+  rewriteManifest(dir, manifest);
+  std::string message = manifestError(dir);
+  EXPECT_CONTAINS(message, "scene.vol.json: fields.custom_mask.components: 2, but ");
+  EXPECT_CONTAINS(message, "scene.custom_mask.nrrd has 1 components");
+
+  // A known field whose NRRD has the wrong count, with no count in the manifest.
+  manifest = writeSample(dir);
+  manifest["fields"]["ior"] = {{"file", "scene.sigma_a.nrrd"}};
+  rewriteManifest(dir, manifest);
+  EXPECT_CONTAINS(manifestError(dir), "scene.vol.json: fields.ior: ");
+}
+
+TEST(VolumeMalformed, DimsDisagreeWithNrrdSizes) {
+  TempDir dir;
+  json manifest = writeSample(dir);
+  manifest["dims"] = {8, 6, 5};
+  rewriteManifest(dir, manifest);
+  std::string message = manifestError(dir);
+  EXPECT_CONTAINS(message, (dir / "scene.vol.json").string() + ": fields.");
+  EXPECT_CONTAINS(message, ".nrrd: sizes 8 6 4 do not match the manifest's dims 8 6 5");
+}
+
+TEST(VolumeMalformed, BoundsDisagreeWithNrrdGeometry) {
+  TempDir dir;
+  json manifest = writeSample(dir);
+  manifest["bounds_max"] = {1.0, 0.75, 1.0};  // voxel size along z changes
+  rewriteManifest(dir, manifest);
+  std::string message = manifestError(dir);
+  EXPECT_CONTAINS(message, "scene.vol.json: fields.");
+  EXPECT_CONTAINS(message, "match the manifest's");
+
+  manifest["bounds_min"] = {-1.0, -0.75, 0.2};  // same voxel size, shifted: the origin disagrees
+  manifest["bounds_max"] = {1.0, 0.75, 1.0};
+  rewriteManifest(dir, manifest);
+  EXPECT_CONTAINS(manifestError(dir), "space origin");
+
+  manifest["bounds_min"] = {-1.0 + 1e-9, -0.75, 0.1};  // within the 1e-4 relative tolerance
+  manifest["bounds_max"] = {1.0, 0.75, 0.9};
+  rewriteManifest(dir, manifest);
+  EXPECT_NO_THROW(readVolume(dir / "scene.vol.json"));
+
+  manifest["bounds_max"] = {1.0, 0.75, 0.1};
+  rewriteManifest(dir, manifest);
+  EXPECT_CONTAINS(manifestError(dir), "scene.vol.json: bounds_max: must be greater than bounds_min");
+}
+
+TEST(VolumeMalformed, JsonSyntaxAndStructure) {
+  TempDir dir;
+  writeSample(dir);
+  spill(dir / "scene.vol.json", "{\n  \"format\": \"eikonal-volume\",\n  \"dims\": [8, 6, 4\n}\n");
+  std::string message = manifestError(dir);
+  EXPECT_CONTAINS(message, (dir / "scene.vol.json").string() + ": JSON: ");
+  EXPECT_CONTAINS(message, "line 4");
+
+  spill(dir / "scene.vol.json", "[1, 2, 3]");
+  EXPECT_CONTAINS(manifestError(dir), "scene.vol.json: JSON: expected an object");
+
+  json manifest = writeSample(dir);
+  manifest["format"] = "something-else";
+  rewriteManifest(dir, manifest);
+  EXPECT_CONTAINS(manifestError(dir), "scene.vol.json: format: ");
+
+  manifest = writeSample(dir);
+  manifest["version"] = 2;
+  rewriteManifest(dir, manifest);
+  EXPECT_CONTAINS(manifestError(dir), "scene.vol.json: version: 2 is not supported");
+
+  manifest = writeSample(dir);
+  manifest.erase("fields");
+  rewriteManifest(dir, manifest);
+  EXPECT_CONTAINS(manifestError(dir), "scene.vol.json: fields: missing");
+
+  manifest = writeSample(dir);
+  manifest["fields"]["ior"].erase("file");
+  rewriteManifest(dir, manifest);
+  EXPECT_CONTAINS(manifestError(dir), "scene.vol.json: fields.ior.file: missing");
+
+  manifest = writeSample(dir);
+  manifest["bounds_min"] = {0, "a", 0};
+  rewriteManifest(dir, manifest);
+  EXPECT_CONTAINS(manifestError(dir), "scene.vol.json: bounds_min: ");
+
+  std::string absent = inputErrorOf([&] { readVolume(dir / "absent.vol.json"); });
+  EXPECT_CONTAINS(absent, (dir / "absent.vol.json").string() + ": cannot open");
+}
+
+TEST(VolumeMalformed, NrrdErrorsNameTheManifestFieldAndFile) {
+  TempDir dir;
+  writeSample(dir, {false, false});
+  fs::path nrrd = dir / "scene.scatter.nrrd";
+  std::string bytes = slurp(nrrd);
+  spill(nrrd, bytes.substr(0, bytes.size() - 8));
+  std::string message = manifestError(dir);
+  EXPECT_CONTAINS(message, (dir / "scene.vol.json").string() + ": fields.scatter: " + nrrd.string() + ": data: truncated");
+}
+
+TEST(VolumeMalformed, WholeVolumeOverTheMemoryLimit) {
+  TempDir dir;
+  writeSample(dir);
+  // The largest field (opaque, 4 × 192 floats) is 3072 bytes; all five together are 8448.
+  ::setenv("EIKONAL_MEMORY_LIMIT_BYTES", "3100", 1);
+  std::string message = manifestError(dir);
+  ::unsetenv("EIKONAL_MEMORY_LIMIT_BYTES");
+  EXPECT_CONTAINS(message, (dir / "scene.vol.json").string() + ": fields: needs ");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Atomic writes (DESIGN §4.1)
+
+TEST(VolumeWrite, FailureMidWriteLeavesNoFiles) {
+  TempDir dir;
+  Volume volume = sampleVolume();
+  // Fields are written in name order; a NaN in the last one fails after the others were staged.
+  volume.fields.at("sigma_a").data[5] = std::numeric_limits<float>::quiet_NaN();
+  try {
+    writeVolume(volume, dir / "scene.vol.json");
+    FAIL() << "expected RuntimeError";
+  } catch (const RuntimeError& e) {
+    EXPECT_CONTAINS(e.what(), "scene.sigma_a.nrrd: data: NaN");
+  }
+  EXPECT_TRUE(dir.entries().empty()) << ::testing::PrintToString(dir.entries());
+}
+
+TEST(VolumeWrite, FailedRewriteKeepsTheOldVolume) {
+  TempDir dir;
+  writeSample(dir, {true, true});
+  std::vector<std::string> before = dir.entries();
+  std::string manifest = slurp(dir / "scene.vol.json");
+  std::string ior = slurp(dir / "scene.ior.raw.gz");
+
+  Volume volume = sampleVolume();
+  volume.fields.at("ior").data.assign(volume.fields.at("ior").data.size(), 1.5f);
+  volume.fields.at("sigma_a").data[0] = std::numeric_limits<float>::infinity();
+  EXPECT_THROW(writeVolume(volume, dir / "scene.vol.json", {true, true}), RuntimeError);
+  EXPECT_EQ(dir.entries(), before);
+  EXPECT_EQ(slurp(dir / "scene.vol.json"), manifest);
+  EXPECT_EQ(slurp(dir / "scene.ior.raw.gz"), ior);
+}
+
+TEST(VolumeWrite, UnwritableDestinationLeavesNoFiles) {
+  TempDir dir;
+  std::string message = inputErrorOf([&] { writeVolume(sampleVolume(), dir / "missing" / "scene.vol.json"); });
+  EXPECT_CONTAINS(message, "does not exist");
+  spill(dir / "file", "not a directory");
+  EXPECT_ANY_THROW(writeVolume(sampleVolume(), dir / "file" / "scene.vol.json"));
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"file"});
+}
+
+TEST(VolumeWrite, RejectsInconsistentVolumes) {
+  TempDir dir;
+  Volume volume = sampleVolume();
+  volume.fields.at("ior").data.pop_back();
+  EXPECT_THROW(writeVolume(volume, dir / "a.vol.json"), RuntimeError);
+  volume = sampleVolume();
+  volume.fields["sigma_a"].components = 1;
+  EXPECT_THROW(writeVolume(volume, dir / "b.vol.json"), RuntimeError);
+  volume = sampleVolume();
+  volume.fields["../escape"] = volume.fields.at("ior");
+  EXPECT_THROW(writeVolume(volume, dir / "c.vol.json"), RuntimeError);
+  volume = sampleVolume();
+  volume.grid.bounds_max.x = volume.grid.bounds_min.x;
+  EXPECT_THROW(writeVolume(volume, dir / "d.vol.json"), RuntimeError);
+  EXPECT_TRUE(dir.entries().empty());
+}
+
+}  // namespace
+}  // namespace eik

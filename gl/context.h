@@ -1,0 +1,113 @@
+// An OpenGL 3.3 core context (DESIGN §3): one interface, three back ends.
+//   OSMesa  headless, software (llvmpipe); the default headless back end.
+//   EGL     headless without a display: EGL_EXT_platform_device (GPU servers), then
+//           EGL_MESA_platform_surfaceless, then the default display. Survives Mesa ≥ 25.1, which
+//           dropped OSMesa.
+//   Window  a GLFW window (X11/Wayland), visible or hidden, for the interactive viewer.
+// Every back end asks for 3.3 core and accepts anything newer (Mesa gives 4.5). Creating a context
+// makes it current and loads glad's function pointers from that context's own getProcAddress.
+//
+// Headless contexts have no usable default framebuffer: render into a gl::Framebuffer.
+// GL objects (gl/texture.h, ...) must be destroyed while their context is current and before it;
+// an object that outlives its context skips its glDelete* (the context took everything with it).
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/vec2.hpp>
+
+struct GLFWwindow;
+
+namespace eik::gl {
+
+enum class GlBackend { Auto, OSMesa, EGL, Window };
+
+// "auto" | "osmesa" | "egl" | "window" (any case); InputError naming `source` otherwise.
+GlBackend parseGlBackend(std::string_view text, std::string_view source = "--gl");
+std::string_view glBackendName(GlBackend backend);
+// The back end EIKONAL_GL names, or `fallback` when it is unset or empty.
+GlBackend glBackendFromEnvironment(GlBackend fallback = GlBackend::Auto);
+
+struct ContextOptions {
+  // Auto: EIKONAL_GL when set, else headless: OSMesa, then EGL if OSMesa fails.
+  GlBackend backend = GlBackend::Auto;
+  // Window: the window size in screen coordinates. OSMesa: its own (unused) colour buffer.
+  glm::ivec2 size{1, 1};
+  std::string title = "Eikonal";  // Window
+  bool visible = true;            // Window: false makes a hidden window (off-screen rendering)
+  bool resizable = true;          // Window
+  int swapInterval = 1;           // Window: 1 = vsync
+  // GL error checks and the debug message callback (gl/debug.h); default: debugRequestedByEnvironment().
+  std::optional<bool> debug = std::nullopt;
+};
+
+struct GlInfo {
+  GlBackend backend = GlBackend::Auto;
+  std::string platform;  // "OSMesa", "EGL 1.5 surfaceless (Mesa Project)", "GLFW 3.3.8 X11 GLX ..."
+  std::string vendor;    // GL_VENDOR, e.g. "Mesa"
+  std::string renderer;  // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
+  std::string version;   // GL_VERSION, e.g. "4.5 (Core Profile) Mesa 22.3.6"
+  std::string glslVersion;
+  int major = 0, minor = 0;
+  bool coreProfile = false;
+  bool debugOutput = false;  // a debug message callback is installed
+  int maxTextureSize = 0;
+  int max3DTextureSize = 0;
+  int maxColorAttachments = 0;
+  int maxDrawBuffers = 0;
+  int maxTextureImageUnits = 0;  // in the fragment shader
+};
+
+namespace detail {
+class ContextBackend;
+}
+
+class GlContext {
+ public:
+  // Creates the context and makes it current. Throws RuntimeError("could not create an OpenGL 3.3
+  // core context with OSMesa: ...") when the back end cannot give one.
+  explicit GlContext(const ContextOptions& options = {});
+  ~GlContext();
+  GlContext(const GlContext&) = delete;
+  GlContext& operator=(const GlContext&) = delete;
+
+  // The context current on this thread (made current through this class), or nullptr.
+  static GlContext* current();
+  // A number that no other context of this process has had (addresses can be reused): GL objects
+  // remember it to delete themselves only in the context that made them.
+  unsigned long long serial() const { return serial_; }
+  // The serial of the context current on this thread, 0 if none.
+  static unsigned long long currentSerial();
+
+  // Makes this context current on this thread (reloading the function pointers if the previous
+  // current context came from another back end).
+  void makeCurrent();
+
+  GlBackend backend() const;
+  const GlInfo& info() const { return info_; }
+  // "llvmpipe (LLVM 15.0.6, 256 bits), OpenGL 4.5 (Core Profile) Mesa 22.3.6, via OSMesa"
+  std::string summary() const;
+  bool hasExtension(std::string_view name) const;
+  bool debug() const { return debug_; }
+
+  // Window back end; for headless contexts window() is nullptr and the rest do nothing.
+  bool isWindow() const;
+  GLFWwindow* window() const;
+  void swapBuffers();
+  bool shouldClose() const;
+  glm::ivec2 framebufferSize() const;  // in pixels; headless: the size asked for
+  static void pollEvents();            // GLFW events of every window (no-op without a window)
+
+ private:
+  std::unique_ptr<detail::ContextBackend> backend_;
+  GlInfo info_;
+  std::vector<std::string> extensions_;  // sorted
+  bool debug_ = false;
+  unsigned long long serial_ = 0;
+};
+
+}  // namespace eik::gl

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Installs what Eikonal needs from Debian 12's packages. Idempotent: does nothing (quickly) when
+# everything is already there.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config git
+  libosmesa6-dev libegl-dev libegl-mesa0 libgl1-mesa-dri
+  libglfw3-dev libglm-dev libopenimageio-dev openimageio-tools libtinygltf-dev python3-glad
+  nlohmann-json3-dev libcli11-dev zlib1g-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  xvfb xauth
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+
+echo "setup: installing ${missing[*]}"
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  SUDO="sudo"
+fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
