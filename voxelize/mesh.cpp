@@ -61,9 +61,10 @@ double TriangleMesh::signedVolume() const {
   return sum / 6.0;
 }
 
-MeshTopology TriangleMesh::topology() const {
-  MeshTopology topo;
-  // Weld: give every distinct position one id (lexicographic sort, exact comparison).
+namespace {
+
+// Welding: one id per distinct position (lexicographic sort, exact comparison). Returns the count.
+std::uint32_t weldPositions(const std::vector<glm::dvec3>& positions, std::vector<std::uint32_t>& weld) {
   std::vector<std::uint32_t> order(positions.size());
   std::iota(order.begin(), order.end(), 0u);
   auto less = [&](std::uint32_t a, std::uint32_t b) {
@@ -73,13 +74,29 @@ MeshTopology TriangleMesh::topology() const {
     return p.z < q.z;
   };
   std::sort(order.begin(), order.end(), less);
-  std::vector<std::uint32_t> weld(positions.size(), 0);
+  weld.assign(positions.size(), 0);
   std::uint32_t next = 0;
   for (std::size_t i = 0; i < order.size(); ++i) {
     if (i > 0 && positions[order[i]] != positions[order[i - 1]]) ++next;
     weld[order[i]] = next;
   }
-  topo.vertices = positions.empty() ? 0 : next + 1;
+  return positions.empty() ? 0 : next + 1;
+}
+
+std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t v) {
+  while (parent[v] != v) {
+    parent[v] = parent[parent[v]];
+    v = parent[v];
+  }
+  return v;
+}
+
+}  // namespace
+
+MeshTopology TriangleMesh::topology() const {
+  MeshTopology topo;
+  std::vector<std::uint32_t> weld;
+  topo.vertices = weldPositions(positions, weld);
 
   std::vector<std::uint64_t> edges;
   edges.reserve(triangles.size() * 3);
@@ -105,6 +122,30 @@ MeshTopology TriangleMesh::topology() const {
     i = j;
   }
   return topo;
+}
+
+std::vector<std::uint32_t> TriangleMesh::triangleComponents(std::uint32_t* count) const {
+  std::vector<std::uint32_t> weld;
+  const std::uint32_t vertices = weldPositions(positions, weld);
+  std::vector<std::uint32_t> parent(vertices);
+  std::iota(parent.begin(), parent.end(), 0u);
+  for (const glm::uvec3& t : triangles) {
+    const std::uint32_t a = findRoot(parent, weld[t[0]]);
+    for (int c = 1; c < 3; ++c) {
+      const std::uint32_t b = findRoot(parent, weld[t[c]]);
+      if (b != a) parent[b] = a;
+    }
+  }
+  std::vector<std::uint32_t> ids(triangles.size());
+  std::vector<std::uint32_t> label(vertices, UINT32_MAX);
+  std::uint32_t next = 0;
+  for (std::size_t i = 0; i < triangles.size(); ++i) {
+    std::uint32_t& l = label[findRoot(parent, weld[triangles[i][0]])];
+    if (l == UINT32_MAX) l = next++;
+    ids[i] = l;
+  }
+  if (count) *count = next;
+  return ids;
 }
 
 void TriangleMesh::transform(const glm::dmat4& matrix) {

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -70,6 +71,9 @@ struct TriangleMesh {
   // outward-facing triangles, negative for a mesh whose normals all point inwards.
   double signedVolume() const;
   MeshTopology topology() const;
+  // Connected components (triangles sharing a vertex position): one id per triangle, ids 0..count−1
+  // in order of first appearance.
+  std::vector<std::uint32_t> triangleComponents(std::uint32_t* count = nullptr) const;
   std::size_t boundaryEdgeCount() const { return topology().boundary_edges; }
   bool isClosed() const { return topology().closed(); }
 

@@ -63,8 +63,10 @@ struct Crossing {
 };
 
 // Per-voxel vote between the axes' estimates c[a] (weight[a] valid sub-rays; 0 = none). Returns the
-// coverage, or −1 when the voxel has to be decided by the winding number.
-float voteAxes(const double c[3], const int weight[3], double tolerance) {
+// coverage, or −1 when the voxel has to be decided by the winding number: fewer than two axes with
+// valid rays, or valid axes that disagree by more than `tolerance` (with `majority`, a lone outlier
+// among three is outvoted instead).
+float voteAxes(const double c[3], const int weight[3], double tolerance, bool majority) {
   // Fast path for the vast majority of voxels: all three axes valid and in full agreement.
   if (weight[0] > 0 && weight[1] > 0 && weight[2] > 0 && c[0] == c[1] && c[1] == c[2])
     return static_cast<float>(c[0]);
@@ -72,24 +74,26 @@ float voteAxes(const double c[3], const int weight[3], double tolerance) {
   int n = 0;
   for (int a = 0; a < 3; ++a)
     if (weight[a] > 0) axes[n++] = a;
-  auto mean = [&](int i, int j, int k) {
+  if (n < 2) return -1.0f;
+  auto mean = [&](int first, int count) {
     double sum = 0.0, total = 0.0;
-    for (int a : {i, j, k})
-      if (a >= 0) {
-        sum += weight[a] * c[a];
-        total += weight[a];
-      }
+    for (int i = first; i < first + count; ++i) {
+      sum += weight[axes[i]] * c[axes[i]];
+      total += weight[axes[i]];
+    }
     return static_cast<float>(sum / total);
   };
-  if (n < 2) return -1.0f;
-  if (n == 2) return std::abs(c[axes[0]] - c[axes[1]]) <= tolerance ? mean(axes[0], axes[1], -1) : -1.0f;
   if (c[axes[1]] < c[axes[0]]) std::swap(axes[0], axes[1]);
-  if (c[axes[2]] < c[axes[1]]) std::swap(axes[1], axes[2]);
-  if (c[axes[1]] < c[axes[0]]) std::swap(axes[0], axes[1]);
-  const double lo = c[axes[0]], mid = c[axes[1]], hi = c[axes[2]];
-  if (hi - lo <= tolerance) return mean(axes[0], axes[1], axes[2]);
-  if (mid - lo <= hi - mid) return mid - lo <= tolerance ? mean(axes[0], axes[1], -1) : -1.0f;
-  return hi - mid <= tolerance ? mean(axes[1], axes[2], -1) : -1.0f;
+  if (n == 3) {
+    if (c[axes[2]] < c[axes[1]]) std::swap(axes[1], axes[2]);
+    if (c[axes[1]] < c[axes[0]]) std::swap(axes[0], axes[1]);
+  }
+  const double lo = c[axes[0]], hi = c[axes[n - 1]];
+  if (hi - lo <= tolerance) return mean(0, n);
+  if (!majority || n < 3) return -1.0f;
+  const double mid = c[axes[1]];
+  if (mid - lo <= hi - mid) return mid - lo <= tolerance ? mean(0, 2) : -1.0f;
+  return hi - mid <= tolerance ? mean(1, 2) : -1.0f;
 }
 
 class SolidVoxelizer {
@@ -328,7 +332,7 @@ class SolidVoxelizer {
         c[0] = axis_estimate_[0][index] / 65535.0;
         c[1] = axis_estimate_[1][index] / 65535.0;
         c[2] = estimate[static_cast<std::size_t>(i) * nw + k];
-        const float voted = voteAxes(c, weight, options_.axis_agreement);
+        const float voted = voteAxes(c, weight, options_.axis_agreement, options_.majority_vote);
         if (voted >= 0.0f) coverage[index] = voted;
         else undecided.push_back(static_cast<std::uint32_t>(k) * static_cast<std::uint32_t>(nu) +
                                  static_cast<std::uint32_t>(i));
@@ -351,7 +355,6 @@ class SolidVoxelizer {
       return;
     }
     const FastWindingNumber winding(mesh_, options_.winding_beta);
-    const double orientation = mesh_.signedVolume() < 0.0 ? -1.0 : 1.0;
     const double threshold = options_.winding_threshold;
     const glm::dvec3 h = grid_.voxelSize();
     const int S = S_;
@@ -371,9 +374,18 @@ class SolidVoxelizer {
         auto inside = [&](int a, int b, int d) {
           const glm::dvec3 p = grid_.bounds_min + (glm::dvec3(i, j, k) + (glm::dvec3(a, b, d) + 0.5) / double(S)) * h;
           ++evals;
-          return winding(p) * orientation > threshold;
+          return std::abs(winding(p)) > threshold;
         };
-        if (!touched_[index]) {  // no surface seen inside: try the corner sub-samples first
+        if (!touched_[index]) {
+          // No surface seen inside: w is smooth (harmonic) across the voxel. Clearly on one side
+          // at the centre → the whole voxel; otherwise the corner sub-samples, then all of them.
+          const glm::dvec3 centre = grid_.center(i, j, k);
+          ++evals;
+          const double w = std::abs(winding(centre)) - threshold;
+          if (std::abs(w) > 0.25) {
+            coverage[index] = w > 0.0 ? 1.0f : 0.0f;
+            continue;
+          }
           int count = 0;
           for (int corner = 0; corner < 8; ++corner)
             count += inside((corner & 1) ? S - 1 : 0, (corner & 2) ? S - 1 : 0, (corner & 4) ? S - 1 : 0) ? 1 : 0;
@@ -536,33 +548,82 @@ void voxelizeSurfaceLayer(const TriangleMesh& mesh, const GridSpec& grid, const 
 
 }  // namespace
 
-bool isOpenSurface(const TriangleMesh& mesh, const GridSpec& grid, const MeshVoxelizeOptions& options,
-                   std::string* reason) {
-  const double area = mesh.area();
-  const double openness = mesh.openness();
-  const double volume = std::abs(mesh.signedVolume());
+namespace {
+
+// How sheet-like a mesh is, measured per connected component so that separate parts cannot cancel
+// (two sheets facing opposite ways, or a solid with an inverted twin). A "soup" whose triangles
+// share no vertices (more than one component per four triangles) is measured as a whole instead.
+struct SheetMeasures {
+  double area = 0.0;
+  double openness = 0.0;  // Σ_c |vector area_c| / Σ_c area_c
+  double volume = 0.0;    // Σ_c |signed volume_c| about each component's area centroid
+  std::uint32_t components = 0;
+};
+
+SheetMeasures measureSheets(const TriangleMesh& mesh) {
+  SheetMeasures m;
+  std::vector<std::uint32_t> ids = mesh.triangleComponents(&m.components);
+  if (m.components > std::max<std::size_t>(1, mesh.triangles.size() / 4)) {
+    std::fill(ids.begin(), ids.end(), 0u);
+    m.components = 1;
+  }
+  const std::size_t n = m.components;
+  std::vector<glm::dvec3> vector_area(n, glm::dvec3(0.0)), centroid(n, glm::dvec3(0.0));
+  std::vector<double> area(n, 0.0), volume(n, 0.0);
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const glm::dvec3 a = mesh.corner(t, 0), b = mesh.corner(t, 1), c = mesh.corner(t, 2);
+    const glm::dvec3 va = 0.5 * glm::cross(b - a, c - a);
+    const double ta = glm::length(va);
+    vector_area[ids[t]] += va;
+    area[ids[t]] += ta;
+    centroid[ids[t]] += ta * (a + b + c) / 3.0;
+  }
+  for (std::size_t c = 0; c < n; ++c)
+    if (area[c] > 0.0) centroid[c] /= area[c];
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const glm::dvec3& o = centroid[ids[t]];
+    volume[ids[t]] += glm::dot(mesh.corner(t, 0) - o, glm::cross(mesh.corner(t, 1) - o, mesh.corner(t, 2) - o)) / 6.0;
+  }
+  double open = 0.0;
+  for (std::size_t c = 0; c < n; ++c) {
+    m.area += area[c];
+    open += glm::length(vector_area[c]);
+    m.volume += std::abs(volume[c]);
+  }
+  m.openness = m.area > 0.0 ? std::min(1.0, open / m.area) : 0.0;
+  return m;
+}
+
+bool classifyOpenSurface(const SheetMeasures& m, const GridSpec& grid, const MeshVoxelizeOptions& options,
+                         std::string& reason) {
   const glm::dvec3 h3 = grid.voxelSize();
   const double h = (h3.x + h3.y + h3.z) / 3.0;
-  auto say = [&](const std::string& s) {
-    if (reason) *reason = s;
-  };
   char buffer[256];
-  if (openness > options.open_surface_openness) {
-    std::snprintf(buffer, sizeof buffer, "open surface: openness |sum of area vectors|/area = %.3f > %.3f", openness,
-                  options.open_surface_openness);
-    say(buffer);
-    return true;
-  }
-  if (area > 0.0 && volume < options.thin_volume_voxels * area * h) {
+  bool surface = false;
+  if (m.openness > options.open_surface_openness) {
+    std::snprintf(buffer, sizeof buffer, "open surface: openness |sum of area vectors|/area = %.3f > %.3f",
+                  m.openness, options.open_surface_openness);
+    surface = true;
+  } else if (m.area > 0.0 && m.volume < options.thin_volume_voxels * m.area * h) {
     std::snprintf(buffer, sizeof buffer,
                   "open surface: encloses %.3g, less than %.3g x area x voxel size (a sheet thinner than %.3g voxel)",
-                  volume, options.thin_volume_voxels, 2.0 * options.thin_volume_voxels);
-    say(buffer);
-    return true;
+                  m.volume, options.thin_volume_voxels, 2.0 * options.thin_volume_voxels);
+    surface = true;
+  } else {
+    std::snprintf(buffer, sizeof buffer, "solid: openness %.3f, enclosed volume %.6g", m.openness, m.volume);
   }
-  std::snprintf(buffer, sizeof buffer, "solid: openness %.3f, enclosed volume %.6g", openness, volume);
-  say(buffer);
-  return false;
+  reason = buffer;
+  return surface;
+}
+
+}  // namespace
+
+bool isOpenSurface(const TriangleMesh& mesh, const GridSpec& grid, const MeshVoxelizeOptions& options,
+                   std::string* reason) {
+  std::string why;
+  const bool surface = classifyOpenSurface(measureSheets(mesh), grid, options, why);
+  if (reason) *reason = why;
+  return surface;
 }
 
 Region voxelizeMesh(const TriangleMesh& mesh, const GridSpec& grid, const MeshVoxelizeOptions& options,
@@ -583,12 +644,13 @@ Region voxelizeMesh(const TriangleMesh& mesh, const GridSpec& grid, const MeshVo
   if (!(h.x > 0.0 && h.y > 0.0 && h.z > 0.0)) throw InputError(mesh.name, "grid", "bounds have no extent");
 
   stats.topology = mesh.topology();
-  stats.area = mesh.area();
+  const SheetMeasures sheets = measureSheets(mesh);
+  stats.area = sheets.area;
   stats.signed_volume = mesh.signedVolume();
-  stats.openness = mesh.openness();
+  stats.openness = sheets.openness;
   bool surface = false;
   switch (options.surface_mode) {
-    case SurfaceMode::Auto: surface = isOpenSurface(mesh, grid, options, &stats.decision); break;
+    case SurfaceMode::Auto: surface = classifyOpenSurface(sheets, grid, options, stats.decision); break;
     case SurfaceMode::Solid: surface = false; stats.decision = "solid (forced)"; break;
     case SurfaceMode::Surface: surface = true; stats.decision = "open surface (forced)"; break;
   }

@@ -16,28 +16,36 @@
 //     is ≠ 0 (so flipped normals, nested or duplicated parts are inside too), and adds the exact
 //     1-D overlap of those intervals with each voxel (difference array + prefix sum).
 //  3. Per voxel and axis the estimate c_a = inside length / valid sub-ray length is exact along the
-//     axis and S×S-supersampled across it. The axes vote: estimates within `axis_agreement` of each
-//     other are averaged (weighted by valid sub-rays); a lone outlier among three is dropped (a
-//     ray that entered and left through two holes reads "outside" along a whole chord, and the
-//     other two axes outvote it). Voxels where fewer than two axes have valid rays, or the valid
-//     ones disagree, are decided by the generalized winding number (Jacobson et al. 2013, with the
-//     hierarchical evaluation of Barill et al. 2018, winding_number.h) at S³ sub-samples
-//     (inside where w·orientation > ½; 8 samples first where no ray crossed the voxel).
+//     axis and S×S-supersampled across it. The axes vote: when every axis with valid rays (at least
+//     two) agrees within `axis_agreement`, the voxel gets their mean weighted by valid sub-rays. A
+//     ray that enters and leaves through two holes is consistent yet wrong ("outside" along a whole
+//     chord), and along a seam — a lid resting in a body with a gap, a shell split at its equator —
+//     rays of two axes slip through the same gap, so a majority would be wrong too: any
+//     disagreement, and any voxel with fewer than two valid axes, is decided by the generalized
+//     winding number instead (Jacobson et al. 2013, with the hierarchical evaluation of Barill et
+//     al. 2018, winding_number.h): inside where |w| > ½, at the voxel centre when that is clearly
+//     on one side and no ray crossed the surface inside the voxel, else at 8 and then S³ sub-samples.
+//     (`majority_vote` outvotes a lone outlier instead: cheaper on very leaky meshes, wrong on seams.)
 //  Why: on a closed mesh every ray is consistent and the result is exact along rays — no winding
 //  number is evaluated at all and the cost is that of a scan conversion (linear in voxel count);
-//  on leaky meshes only the voxels whose rays all pass through holes pay for the (more robust,
-//  but ~100× dearer) winding number. Parity counting would break on overlapping parts, a single
-//  axis on any hole, and the winding number alone would cost far more than the 2-s budget.
+//  on leaky meshes only the voxels whose rays pass through holes pay for the (more robust, but
+//  ~100× dearer) winding number. Parity counting would break on overlapping parts, a single axis
+//  on any hole, and the winding number alone would cost far more than the 2-s budget at 256³.
+//  Measured on 2 cores: a closed 70k-triangle torus at 256³ in 0.5 s; with 0.5 % of its faces
+//  removed 0.6 s (2 000 voxels by winding number, volume within 1e-5 of the closed one); a sphere
+//  split at the equator with a one-voxel gap comes out filled (within 0.01 % of sphere + band).
 //
 // OPEN SURFACES (a floor, a table top as a single sheet) are not solids: they become a thin opaque
 // receiver layer — coverage = clamp((T/2 + h/2 − d)/h, 0, 1) with d the exact distance from the
 // voxel centre to the nearest triangle, h the voxel size and T = surface_thickness_voxels·h, so a
 // plane yields T·area of coverage volume (plus a rounded rim of πh/6 × T/h per unit length of
 // open boundary, half a voxel of blur at the edge) — with enclosed_volume = 0 and the material made
-// opaque (albedo kept). Auto mode calls a mesh an open surface when its openness |Σ area vectors| / area
-// exceeds `open_surface_openness` (0 for any closed surface, ≈ 0 for a solid with holes, ≈ 1 for a
-// sheet; the boundary-edge fraction is not used because scans with many small holes have a large
-// one), or when it encloses almost no volume: |V| < thin_volume_voxels · area · h.
+// opaque (albedo kept). Auto mode calls a mesh an open surface when its openness
+// Σ_c |Σ area vectors| / area exceeds `open_surface_openness` (0 for any closed surface, ≈ 0 for a
+// solid with holes, ≈ 1 for a sheet), or when it encloses almost no volume,
+// Σ_c |V_c| < thin_volume_voxels · area · h — both summed over connected components c so that
+// oppositely oriented parts cannot cancel. The boundary-edge fraction is reported but not used: a
+// scan with many small holes has a large one, a finely tessellated floor a small one.
 #pragma once
 
 #include <cstdint>
@@ -59,6 +67,10 @@ struct MeshVoxelizeOptions {
   double open_surface_openness = 0.25;    // Auto: openness above this → open surface
   double thin_volume_voxels = 0.05;       // Auto: |V| < this · area · h → open surface
   double axis_agreement = 0.35;           // per-axis voxel estimates closer than this agree
+  // false: any disagreement between valid axes sends the voxel to the winding number (robust to
+  // seams, where rays of two axes slip through the same gap); true: a lone outlier among three
+  // axes is outvoted (cheaper on meshes with many holes, wrong on seams).
+  bool majority_vote = false;
   double winding_threshold = 0.5;         // inside where the generalized winding number exceeds this
   double winding_beta = 3.0;              // Barnes–Hut accuracy of the winding number (larger: exacter)
 };

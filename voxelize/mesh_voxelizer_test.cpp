@@ -98,6 +98,47 @@ TEST(MeshVoxelizer, SphereWithHolesKeepsItsVolume) {
   EXPECT_LT(differing * grid.voxelVolume(), 0.005 * a.enclosed_volume);
 }
 
+TEST(MeshVoxelizer, OpenSeamIsBridged) {
+  // A teapot-like seam: the upper hemisphere lifted by one voxel, leaving a ring-shaped gap. Rays of
+  // two axes slip through the gap in its plane (consistently: no crossing at all), so voting alone
+  // would cut the ball in two; the winding number bridges the gap.
+  const double R = 1.0;
+  const GridSpec grid = cubeGrid(glm::dvec3(0.0), 2.4 * R, 96);
+  const double gap = grid.voxelSize().x;
+  const TriangleMesh ball = makeUvSphere(glm::dvec3(0.0), R, 64, 32);
+  TriangleMesh seam = ball;
+  seam.triangles.clear();
+  std::vector<int> lifted(ball.positions.size(), -1);
+  for (glm::uvec3 t : ball.triangles) {
+    const double cz = (ball.positions[t[0]].z + ball.positions[t[1]].z + ball.positions[t[2]].z) / 3.0;
+    for (int c = 0; c < 3 && cz > 0.0; ++c) {
+      if (std::abs(ball.positions[t[c]].z) > 1e-12) continue;  // equator vertex of an upper triangle
+      if (lifted[t[c]] < 0) {
+        lifted[t[c]] = static_cast<int>(seam.positions.size());
+        seam.positions.push_back(ball.positions[t[c]]);
+      }
+      t[c] = static_cast<unsigned>(lifted[t[c]]);
+    }
+    seam.triangles.push_back(t);
+  }
+  for (std::size_t v = 0; v < seam.positions.size(); ++v) {
+    const bool equator_copy = v >= ball.positions.size();
+    if (equator_copy || seam.positions[v].z > 1e-12) seam.positions[v].z += gap;
+  }
+  ASSERT_EQ(seam.topology().boundary_edges, 128u);
+  MeshVoxelizeStats stats;
+  const Region region = voxelizeMesh(seam, grid, {}, {}, &stats);
+  EXPECT_FALSE(stats.open_surface) << stats.decision;
+  EXPECT_GT(stats.winding_voxels, 0u);
+  const double equator_polygon = 32.0 * std::sin(2.0 * kPi / 64.0) * R * R;
+  const double filled = ball.signedVolume() + equator_polygon * gap;
+  EXPECT_LT(relativeError(region.enclosed_volume, filled), 0.005)
+      << region.enclosed_volume << " vs " << filled << " (two separate halves: " << ball.signedVolume() << ")";
+  // The equatorial plane inside the ball is inside.
+  const int k = static_cast<int>((gap / 2 + 1.2 * R) / grid.voxelSize().z);
+  EXPECT_EQ(region.coverage[grid.index(48, 48, k)], 1.0f);
+}
+
 TEST(MeshVoxelizer, TorusMatchesPappus) {
   const double R = 1.0, r = 0.4;
   const int major = 96, minor = 48;
@@ -262,6 +303,22 @@ TEST(MeshVoxelizer, TiltedSheetAndThinClosedSlabAreSurfaces) {
   for (float c : region.coverage) sum += c;
   const double h = grid.voxelSize().x;
   EXPECT_NEAR(sum * grid.voxelVolume() / h, sheet.area(), 0.05 * sheet.area());
+
+  // Two sheets facing opposite ways (a floor and a ceiling in one mesh) are still sheets: the
+  // decision is made per connected component, so their area vectors do not cancel.
+  TriangleMesh floors = makeRectangle({-0.8, -0.5, 0.8}, {1.6, 0, 0}, {0, 0, -1.6});
+  floors.append(makeRectangle({-0.8, 0.5, -0.8}, {1.6, 0, 0}, {0, 0, 1.6}));
+  ASSERT_LT(floors.openness(), 1e-12);
+  std::string why;
+  EXPECT_TRUE(isOpenSurface(floors, grid, {}, &why)) << why;
+  // A ball with an inverted twin beside it is two solids, not a zero-volume sheet.
+  TriangleMesh twins = makeUvSphere({-0.5, 0, 0}, 0.4, 32, 16);
+  TriangleMesh inverted = makeUvSphere({0.5, 0, 0}, 0.4, 32, 16);
+  inverted.flipWinding();
+  twins.append(inverted);
+  ASSERT_LT(std::abs(twins.signedVolume()), 1e-9);
+  EXPECT_FALSE(isOpenSurface(twins, grid, {}, &why)) << why;
+  EXPECT_LT(relativeError(voxelizeMesh(twins, grid).enclosed_volume, 2.0 * std::abs(inverted.signedVolume())), 0.01);
 
   // A closed box a tenth of a voxel thick is a sheet too.
   const TriangleMesh slab = makeBox({-0.5, 0.0, -0.5}, {0.5, 0.1 * h, 0.5});

@@ -179,7 +179,7 @@ Params::Params(const ShapeDef& shape, const ProceduralSpec& spec) : source_(kPro
       std::vector<std::string> valid;
       for (const auto& def : shape.params) valid.push_back(def.key);
       for (const auto& k : shape.material_keys) valid.push_back(k);
-      const std::string what = isMaterialKey(key) ? "not accepted by shape '" + shape.name + "', which sets it with its own keys"
+      const std::string what = isMaterialKey(key) ? "material key not accepted by shape '" + shape.name + "'"
                                                   : "unknown key for shape '" + shape.name + "'";
       fail(key, what + " (valid keys: " + joined(valid) + ")");
     }
@@ -491,7 +491,7 @@ const std::vector<ShapeDef>& shapeDefs() {
                   triple("sigma_a2", "0.6:0.05:0.6", 0.0, false, "σa of layer2 (green tint; default ÷ size)"),
                   triple("sigma_a3", "0.1:0.9:3", 0.0, false, "σa of layer3 (amber; default ÷ size)"),
                   centerParam()},
-                 materialKeysExcept({"ior", "n", "sigma_a", "name"}), {"layer1", "layer2", "layer3"}, buildLayeredCube});
+                 materialKeysExcept({"ior", "n", "sigma_a", "albedo", "name"}), {"layer1", "layer2", "layer3"}, buildLayeredCube});
     d.push_back({"wine_glass",
                  "lathe-profile wine glass (foot, stem, spherical bowl) with red wine in the lower bowl "
                  "(thesis Fig. 3.1, 3.3b, 7.4b); lengths other than height are fractions of height",
@@ -506,7 +506,7 @@ const std::vector<ShapeDef>& shapeDefs() {
                   triple("wine_sigma_a", "0.5:8:6", 0.0, false,
                          "σa of the wine: passes red (default ÷ height; an explicit value is per world unit)"),
                   centerParam()},
-                 allMaterialKeys(), {"glass", "wine"}, buildWineGlass});
+                 materialKeysExcept({"albedo"}), {"glass", "wine"}, buildWineGlass});
     d.push_back({"logo_block",
                  "glass block with an embedded logo (a ring around the letter E, extruded along z) "
                  "(thesis Fig. 1.1, 7.2a)",
@@ -517,16 +517,16 @@ const std::vector<ShapeDef>& shapeDefs() {
                   triple("logo_sigma_a", "8:8:2", 0.0, false, "σa of the logo glass (dark blue)"),
                   triple("logo_albedo", "", 0.0, false, "if given, the logo is opaque with this albedo instead"),
                   centerParam()},
-                 allMaterialKeys(), {"block", "logo"}, buildLogoBlock});
+                 materialKeysExcept({"albedo"}), {"block", "logo"}, buildLogoBlock});
     d.push_back({"luneburg", "Luneburg lens, n(r) = sqrt(2 - (r/R)^2) inside radius R; per-voxel n",
-                 {positive("r", "0.5", "radius R"), centerParam()}, materialKeysExcept({"ior", "n"}), {"luneburg"},
+                 {positive("r", "0.5", "radius R"), centerParam()}, materialKeysExcept({"ior", "n", "albedo"}), {"luneburg"},
                  buildLuneburg});
     d.push_back({"gradient_slab", "slab whose n varies linearly along an axis from n0 to n1; per-voxel n",
                  {triple("size", "1:1:0.25", 0.0, true, "side lengths X:Y:Z"),
                   choice("axis", "x", {"x", "y", "z"}, "axis along which n varies"),
                   ior("n0", "1.3", "n at the slab's -axis face"), ior("n1", "1.7", "n at the slab's +axis face"),
                   centerParam()},
-                 materialKeysExcept({"ior", "n"}), {"gradient_slab"}, buildGradientSlab});
+                 materialKeysExcept({"ior", "n", "albedo"}), {"gradient_slab"}, buildGradientSlab});
     d.push_back({"floor", "thin opaque receiver plane (x-z square) whose top face is at height y",
                  {num("y", "-0.5", -1e300, 1e300, false, "height of the top face"),
                   positive("size", "2", "side length of the square"),

@@ -65,7 +65,7 @@ TEST(ProceduralSpec, Errors) {
   e = inputErrorOf("procedural:gradient_slab,axis=w");
   EXPECT_NE(e.find("axis: 'w' is not one of x, y, z"), std::string::npos) << e;
   e = inputErrorOf("procedural:luneburg,n=1.5");
-  EXPECT_NE(e.find("procedural:luneburg: n: not accepted"), std::string::npos) << e;
+  EXPECT_NE(e.find("procedural:luneburg: n: material key not accepted"), std::string::npos) << e;
   e = inputErrorOf("procedural:sphere,g=2");
   EXPECT_NE(e.find("g: 2 is outside (-1, 1)"), std::string::npos) << "material keys are validated too: " << e;
   e = inputErrorOf("procedural:rounded_cube,size=1,radius=0.7");

@@ -56,7 +56,9 @@ void main() {
   float tNear, tFar;
   if (intersectBox(o, d, tNear, tFar)) {
     vec3 extent = uBoundsMax - uBoundsMin;
-    vec3 x = o + d * max(tNear, 0.0);
+    // Start a hair inside the box: exactly on its face, rounding would put some rays outside and
+    // end their march before it began (speckles of unrefracted rays).
+    vec3 x = o + d * (max(tNear, 0.0) + 1e-4 * length(extent));
     float n = volumeIor((x - uBoundsMin) / extent);
     vec3 w = d * n;  // |w| = n along an exact ray
     for (int i = 0; i < uMaxSteps; ++i) {
