@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -21,7 +23,15 @@ Field& addZeroField(Volume& volume, const std::string& name, int components, std
 
 bool nonZero(const glm::vec3& v) { return v.x != 0.0f || v.y != 0.0f || v.z != 0.0f; }
 
-nlohmann::json rgb(const glm::vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
+// A float rounded to the 7 significant digits it carries, for the manifest (1.34f → 1.34, not
+// 1.340000033378601).
+double tidy(float v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.7g", static_cast<double>(v));
+  return std::strtod(text, nullptr);
+}
+
+nlohmann::json rgb(const glm::vec3& v) { return nlohmann::json::array({tidy(v.x), tidy(v.y), tidy(v.z)}); }
 
 }  // namespace
 
@@ -128,13 +138,13 @@ Volume compositeRegions(const std::vector<Region>& regions, const GridSpec& grid
     const Material& m = regions[r].material;
     nlohmann::json entry = {{"name", regions[r].name},
                             {"material", m.name},
-                            {"ior", m.ior},
+                            {"ior", tidy(m.ior)},
                             {"ior_varies", !regions[r].ior.empty()},
                             {"sigma_a", rgb(m.sigma_a)},
                             {"emission", rgb(m.emission)},
-                            {"scatter", m.scatter},
-                            {"g", m.g},
-                            {"dispersion_b", m.dispersion_b},
+                            {"scatter", tidy(m.scatter)},
+                            {"g", tidy(m.g)},
+                            {"dispersion_b", tidy(m.dispersion_b)},
                             {"opaque", m.opaque},
                             {"enclosed_volume", regions[r].enclosed_volume},
                             {"volume", sum * voxel_volume}};

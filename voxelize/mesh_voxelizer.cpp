@@ -550,31 +550,33 @@ void voxelizeSurfaceLayer(const TriangleMesh& mesh, const GridSpec& grid, const 
 
 namespace {
 
-// How sheet-like a mesh is, measured per connected component so that separate parts cannot cancel
-// (two sheets facing opposite ways, or a solid with an inverted twin). A "soup" whose triangles
-// share no vertices (more than one component per four triangles) is measured as a whole instead.
+// How sheet-like a mesh is. Openness is measured on the whole mesh, so that the rims of a seam
+// (a lid resting in a body, two halves of a shell with a gap) cancel as they would if closed.
+// Volume is measured per connected component, each about its own area centroid, so that an
+// inverted twin cannot cancel a solid and two opposite sheets (a floor and a ceiling) add up to
+// nothing. A "soup" whose triangles share no vertices (more than 16 components and more than one
+// per four triangles) has its volume measured as a whole instead.
 struct SheetMeasures {
   double area = 0.0;
-  double openness = 0.0;  // Σ_c |vector area_c| / Σ_c area_c
-  double volume = 0.0;    // Σ_c |signed volume_c| about each component's area centroid
+  double openness = 0.0;  // |Σ area vectors| / area
+  double volume = 0.0;    // Σ_c |signed volume_c|
   std::uint32_t components = 0;
 };
 
 SheetMeasures measureSheets(const TriangleMesh& mesh) {
   SheetMeasures m;
   std::vector<std::uint32_t> ids = mesh.triangleComponents(&m.components);
-  if (m.components > std::max<std::size_t>(1, mesh.triangles.size() / 4)) {
-    std::fill(ids.begin(), ids.end(), 0u);
-    m.components = 1;
-  }
-  const std::size_t n = m.components;
-  std::vector<glm::dvec3> vector_area(n, glm::dvec3(0.0)), centroid(n, glm::dvec3(0.0));
+  if (m.components > 16 && m.components > mesh.triangles.size() / 4) std::fill(ids.begin(), ids.end(), 0u);
+  if (ids.empty()) return m;
+  const std::size_t n = *std::max_element(ids.begin(), ids.end()) + 1;
+  std::vector<glm::dvec3> centroid(n, glm::dvec3(0.0));
   std::vector<double> area(n, 0.0), volume(n, 0.0);
+  glm::dvec3 vector_area(0.0);
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     const glm::dvec3 a = mesh.corner(t, 0), b = mesh.corner(t, 1), c = mesh.corner(t, 2);
     const glm::dvec3 va = 0.5 * glm::cross(b - a, c - a);
     const double ta = glm::length(va);
-    vector_area[ids[t]] += va;
+    vector_area += va;
     area[ids[t]] += ta;
     centroid[ids[t]] += ta * (a + b + c) / 3.0;
   }
@@ -584,13 +586,11 @@ SheetMeasures measureSheets(const TriangleMesh& mesh) {
     const glm::dvec3& o = centroid[ids[t]];
     volume[ids[t]] += glm::dot(mesh.corner(t, 0) - o, glm::cross(mesh.corner(t, 1) - o, mesh.corner(t, 2) - o)) / 6.0;
   }
-  double open = 0.0;
   for (std::size_t c = 0; c < n; ++c) {
     m.area += area[c];
-    open += glm::length(vector_area[c]);
     m.volume += std::abs(volume[c]);
   }
-  m.openness = m.area > 0.0 ? std::min(1.0, open / m.area) : 0.0;
+  m.openness = m.area > 0.0 ? std::min(1.0, glm::length(vector_area) / m.area) : 0.0;
   return m;
 }
 
@@ -600,11 +600,13 @@ bool classifyOpenSurface(const SheetMeasures& m, const GridSpec& grid, const Mes
   const double h = (h3.x + h3.y + h3.z) / 3.0;
   char buffer[256];
   bool surface = false;
-  if (m.openness > options.open_surface_openness) {
+  if (m.area <= 0.0) {
+    std::snprintf(buffer, sizeof buffer, "solid: no area (only degenerate triangles)");
+  } else if (m.openness > options.open_surface_openness) {
     std::snprintf(buffer, sizeof buffer, "open surface: openness |sum of area vectors|/area = %.3f > %.3f",
                   m.openness, options.open_surface_openness);
     surface = true;
-  } else if (m.area > 0.0 && m.volume < options.thin_volume_voxels * m.area * h) {
+  } else if (m.volume < options.thin_volume_voxels * m.area * h) {
     std::snprintf(buffer, sizeof buffer,
                   "open surface: encloses %.3g, less than %.3g x area x voxel size (a sheet thinner than %.3g voxel)",
                   m.volume, options.thin_volume_voxels, 2.0 * options.thin_volume_voxels);

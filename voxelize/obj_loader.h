@@ -9,7 +9,8 @@
 //
 // Why not tinyobjloader (Debian has libtinyobjloader-dev 2.0.0~rc10): it turns a non-numeric value
 // into 0 without a word, and we must name the file, line and field of every malformed value
-// (DESIGN §4.2); the few things we need fit in a page, and parsing here runs at ~100 MB/s.
+// (DESIGN §4.2); the few things we need fit in a page, and a 16 MB, 280k-triangle file loads in
+// under 0.1 s.
 #pragma once
 
 #include <filesystem>

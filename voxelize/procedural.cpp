@@ -4,7 +4,6 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
-#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
@@ -674,7 +673,7 @@ Region voxelizeImplicit(const ImplicitSolid& solid, const GridSpec& grid, const 
         if (d >= half_diagonal) {
           // Wholly outside; by the Lipschitz bound so are the next voxels along x while
           // d − m·h.x ≥ half_diagonal.
-          i += static_cast<int>((d - half_diagonal) / h.x);
+          i += static_cast<int>(std::min((d - half_diagonal) / h.x, static_cast<double>(hi.x)));
           continue;
         }
         const std::size_t at = grid.index(i, j, k);
