@@ -4,10 +4,12 @@
 //      display this is the way in, e.g. NVIDIA's EGL);
 //   2. EGL_MESA_platform_surfaceless (Mesa);
 //   3. eglGetDisplay(EGL_DEFAULT_DISPLAY).
-// The first display that gives an OpenGL 3.3 core context wins.
+// The first display that gives an OpenGL 3.3 core context wins (EIKONAL_EGL_PLATFORM restricts
+// the search to one of the three).
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 
+#include <cstdlib>
 #include <map>
 #include <mutex>
 #include <string>
@@ -124,6 +126,17 @@ class EglBackend final : public ContextBackend {
       eglGetError();
     }
 
+    // EIKONAL_EGL_PLATFORM=device|surfaceless|default keeps only that kind of display (to debug
+    // or test one path).
+    if (const char* only = std::getenv("EIKONAL_EGL_PLATFORM"); only && *only) {
+      std::string wanted = std::string(only) == "default" ? "default display" : std::string(only) + " platform";
+      std::erase_if(candidates, [&](const Candidate& c) { return c.name.rfind(wanted, 0) != 0; });
+      if (candidates.empty()) {
+        throw RuntimeError("could not create an OpenGL 3.3 core context with EGL: no " + wanted +
+                           " display (EIKONAL_EGL_PLATFORM=" + only + "; expected device, surfaceless or default)");
+      }
+    }
+
     std::string reasons;
     for (const Candidate& candidate : candidates) {
       std::string reason;
@@ -138,7 +151,8 @@ class EglBackend final : public ContextBackend {
     if (eglGetCurrentContext() == context_) releaseCurrent();
     eglDestroyContext(display_, context_);
     releaseDisplay(display_);
-    eglReleaseThread();
+    // Only with nothing current: eglReleaseThread would also unbind another live context.
+    if (eglGetCurrentContext() == EGL_NO_CONTEXT) eglReleaseThread();
   }
 
   GlBackend kind() const override { return GlBackend::EGL; }

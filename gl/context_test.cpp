@@ -76,6 +76,25 @@ TEST(EglContext, RendersPatternPixelExact) {
   test::renderAndCheckPattern(64, 48);
 }
 
+TEST(EglContext, EachDisplayKindThatExistsRenders) {
+  int rendered = 0;
+  for (const char* platform : {"device", "surfaceless", "default"}) {
+    ScopedEnv env("EIKONAL_EGL_PLATFORM", platform);
+    std::unique_ptr<GlContext> context;
+    try {
+      context = std::make_unique<GlContext>(ContextOptions{.backend = GlBackend::EGL});
+    } catch (const RuntimeError& e) {
+      std::printf("[ egl      ] %s: unavailable: %s\n", platform, e.what());
+      continue;
+    }
+    std::printf("[ egl      ] %s: %s\n", platform, context->summary().c_str());
+    EXPECT_NE(context->info().platform.find(platform), std::string::npos) << context->info().platform;
+    test::renderAndCheckPattern(24, 16);
+    ++rendered;
+  }
+  if (rendered == 0) GTEST_SKIP() << "no EGL display gives a context on this machine";
+}
+
 TEST(GlContextTest, AutoIsHeadlessOSMesaFirst) {
   ScopedEnv env("EIKONAL_GL", nullptr);
   GlContext context;
