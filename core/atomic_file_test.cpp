@@ -2,61 +2,28 @@
 
 #include <unistd.h>
 
-#include <algorithm>
-#include <fstream>
-#include <random>
-#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "core/testing.h"
 
 namespace eik {
 namespace {
 namespace fs = std::filesystem;
 
-// A fresh directory under the system temp dir, removed with everything in it.
-class TempDir {
- public:
-  TempDir() {
-    std::random_device random;
-    path_ = fs::temp_directory_path() /
-            ("eikonal-atomic-" + std::to_string(::getpid()) + "-" + std::to_string(random()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-  // Names of every entry, hidden temporaries included, sorted.
-  std::vector<std::string> entries() const {
-    std::vector<std::string> names;
-    for (const auto& entry : fs::directory_iterator(path_)) names.push_back(entry.path().filename().string());
-    std::sort(names.begin(), names.end());
-    return names;
-  }
-
- private:
-  fs::path path_;
-};
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using test_support::readFile;
+using test_support::TempDir;
 
 TEST(AtomicFile, WriteFileAtomicCreatesAndReplaces) {
   TempDir dir;
   writeFileAtomic(dir / "a.json", "first");
-  EXPECT_EQ(slurp(dir / "a.json"), "first");
+  EXPECT_EQ(readFile(dir / "a.json"), "first");
   writeFileAtomic(dir / "a.json", "second, longer");
-  EXPECT_EQ(slurp(dir / "a.json"), "second, longer");
+  EXPECT_EQ(readFile(dir / "a.json"), "second, longer");
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"a.json"});
 }
 
@@ -80,8 +47,8 @@ TEST(AtomicFile, NothingAppearsBeforeCommit) {
   files.commit();
   EXPECT_TRUE(files.committed());
   EXPECT_EQ(dir.entries(), (std::vector<std::string>{"a.nrrd", "b.vol.json"}));
-  EXPECT_EQ(slurp(dir / "a.nrrd"), "A");
-  EXPECT_EQ(slurp(dir / "b.vol.json"), "B");
+  EXPECT_EQ(readFile(dir / "a.nrrd"), "A");
+  EXPECT_EQ(readFile(dir / "b.vol.json"), "B");
 }
 
 TEST(AtomicFile, AbandonedSetLeavesNothingBehind) {
@@ -96,7 +63,7 @@ TEST(AtomicFile, AbandonedSetLeavesNothingBehind) {
       },
       std::runtime_error);
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"keep.txt"});
-  EXPECT_EQ(slurp(dir / "keep.txt"), "old");
+  EXPECT_EQ(readFile(dir / "keep.txt"), "old");
 }
 
 TEST(AtomicFile, StagedButNeverCreatedIsFine) {

@@ -1,6 +1,5 @@
 #include "core/nrrd.h"
 
-#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -8,55 +7,23 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <random>
-#include <sstream>
 #include <string>
 #include <tuple>
 
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "core/testing.h"
 
 namespace eik {
 namespace {
 namespace fs = std::filesystem;
 
-class TempDir {
- public:
-  TempDir() {
-    std::random_device random;
-    path_ = fs::temp_directory_path() / ("eikonal-nrrd-" + std::to_string(::getpid()) + "-" + std::to_string(random()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-  std::vector<std::string> entries() const {
-    std::vector<std::string> names;
-    for (const auto& entry : fs::directory_iterator(path_)) names.push_back(entry.path().filename().string());
-    std::sort(names.begin(), names.end());
-    return names;
-  }
-
- private:
-  fs::path path_;
-};
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-void spill(const fs::path& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out << bytes;
-}
+using test_support::readFile;
+using test_support::TempDir;
+using test_support::writeFile;
 
 // Little-endian float32 bytes (the test hosts are little-endian; checked below).
 std::string floatBytes(const std::vector<float>& values) {
@@ -173,7 +140,7 @@ INSTANTIATE_TEST_SUITE_P(AllLayouts, NrrdRoundTrip,
 TEST(Nrrd, HeaderCarriesWhatSlicerAndParaViewNeed) {
   TempDir dir;
   writeNrrd(dir / "v.nrrd", randomImage(3, {4, 4, 4}), {});
-  std::string text = slurp(dir / "v.nrrd");
+  std::string text = readFile(dir / "v.nrrd");
   std::string header = text.substr(0, text.find("\n\n") + 1);
   EXPECT_EQ(header.rfind("NRRD0004\n", 0), 0u);
   for (const char* line : {"\n# Eikonal", "\ntype: float\n", "\ndimension: 4\n", "\nspace: right-anterior-superior\n",
@@ -189,7 +156,7 @@ TEST(Nrrd, HeaderCarriesWhatSlicerAndParaViewNeed) {
   EXPECT_EQ(static_cast<unsigned char>(text[data + 1]), 0x8b);
 
   writeNrrd(dir / "s.nhdr", randomImage(1, {4, 4, 4}), {false, true});
-  std::string scalar = slurp(dir / "s.nhdr");
+  std::string scalar = readFile(dir / "s.nhdr");
   EXPECT_CONTAINS(scalar, "\ndimension: 3\n");
   EXPECT_CONTAINS(scalar, "\nkinds: domain domain domain\n");
   EXPECT_CONTAINS(scalar, "\nspace directions: (0.1,0,0) (0,0.2,0) (0,0,");
@@ -197,7 +164,7 @@ TEST(Nrrd, HeaderCarriesWhatSlicerAndParaViewNeed) {
   EXPECT_CONTAINS(scalar, "\ndata file: s.raw\n");
 
   writeNrrd(dir / "two.nrrd", randomImage(2, {2, 2, 2}), {});
-  EXPECT_CONTAINS(slurp(dir / "two.nrrd"), "\nkinds: vector domain domain domain\n");
+  EXPECT_CONTAINS(readFile(dir / "two.nrrd"), "\nkinds: vector domain domain domain\n");
 }
 
 TEST(Nrrd, LargeGzipDataIsOneStandardGzipMember) {
@@ -209,7 +176,7 @@ TEST(Nrrd, LargeGzipDataIsOneStandardGzipMember) {
   EXPECT_EQ(readNrrd(dir / "big.nrrd").data, image.data);
 
   // Plain zlib, asked for a single gzip member, finds the whole data and a valid trailer.
-  std::string text = slurp(dir / "big.nrrd");
+  std::string text = readFile(dir / "big.nrrd");
   std::size_t start = text.find("\n\n") + 2;
   z_stream z{};
   ASSERT_EQ(inflateInit2(&z, 15 + 16), Z_OK);
@@ -228,8 +195,8 @@ TEST(Nrrd, LargeGzipDataIsOneStandardGzipMember) {
 TEST(Nrrd, ReadsSpacingsWithoutSpaceDirections) {
   TempDir dir;
   fs::path file = dir / "hand.nhdr";
-  spill(dir / "hand.raw", floatBytes(ramp(2 * 3 * 4 * 2)));
-  spill(file,
+  writeFile(dir / "hand.raw", floatBytes(ramp(2 * 3 * 4 * 2)));
+  writeFile(file,
         "NRRD0001\n# written by hand\ncontent: test\ntype: float\ndimension: 4\nsizes: 2 2 3 4\n"
         "spacings: nan 0.5 0.25 2\naxis mins: nan 1 2 3\ncenters: ??? cell cell cell\n"
         "endian: little\nencoding: raw\ndata file: ./hand.raw\nunits:=cm\n");
@@ -243,7 +210,7 @@ TEST(Nrrd, ReadsSpacingsWithoutSpaceDirections) {
 
 TEST(Nrrd, NoOrientationMeansUnitSpacingAtTheOrigin) {
   TempDir dir;
-  spill(dir / "plain.nrrd", "NRRD0004\n" + kScalarHeader + "\n" + floatBytes(ramp(24)));
+  writeFile(dir / "plain.nrrd", "NRRD0004\n" + kScalarHeader + "\n" + floatBytes(ramp(24)));
   NrrdImage image = readNrrd(dir / "plain.nrrd");
   EXPECT_EQ(image.directions, glm::dmat3(1.0));
   EXPECT_EQ(image.origin, glm::dvec3(0.0));
@@ -251,7 +218,7 @@ TEST(Nrrd, NoOrientationMeansUnitSpacingAtTheOrigin) {
 
 TEST(Nrrd, ConvertsLpsToRas) {
   TempDir dir;
-  spill(dir / "lps.nrrd",
+  writeFile(dir / "lps.nrrd",
         "NRRD0004\ntype: float\ndimension: 3\nspace: left-posterior-superior\nsizes: 2 3 4\n"
         "space directions: (0.5,0,0) (0,0.25, 0) (0.1,0,2)\nkinds: domain domain domain\nendian: little\n"
         "encoding: raw\nspace origin: (10,-20,30)\n\n" +
@@ -268,19 +235,19 @@ TEST(Nrrd, ReadsBigEndian) {
   std::vector<float> values = ramp(24);
   std::string bytes = floatBytes(values);
   for (std::size_t i = 0; i < bytes.size(); i += 4) std::reverse(bytes.begin() + i, bytes.begin() + i + 4);
-  spill(dir / "be.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nendian: big\nencoding: raw\n\n" + bytes);
+  writeFile(dir / "be.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nendian: big\nencoding: raw\n\n" + bytes);
   EXPECT_EQ(readNrrd(dir / "be.nrrd").data, values);
 }
 
 TEST(Nrrd, HonoursLineSkipAndByteSkip) {
   TempDir dir;
   std::vector<float> values = ramp(24);
-  spill(dir / "skip.raw", "first line\nsecond\nXYZW" + floatBytes(values));
-  spill(dir / "skip.nhdr", "NRRD0004\n" + kScalarHeader + "data file: skip.raw\nline skip: 2\nbyte skip: 4\n");
+  writeFile(dir / "skip.raw", "first line\nsecond\nXYZW" + floatBytes(values));
+  writeFile(dir / "skip.nhdr", "NRRD0004\n" + kScalarHeader + "data file: skip.raw\nline skip: 2\nbyte skip: 4\n");
   EXPECT_EQ(readNrrd(dir / "skip.nhdr").data, values);
 
   // For gzip, byte skip counts decompressed bytes (teem).
-  spill(dir / "skipz.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nendian: little\nencoding: gzip\n"
+  writeFile(dir / "skipz.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nendian: little\nencoding: gzip\n"
                             "byte skip: 8\n\n" + gzipBytes("12345678" + floatBytes(values)));
   EXPECT_EQ(readNrrd(dir / "skipz.nrrd").data, values);
 }
@@ -289,20 +256,20 @@ TEST(Nrrd, ReadsConcatenatedGzipMembers) {
   TempDir dir;
   std::vector<float> values = ramp(24);
   std::string bytes = floatBytes(values);
-  spill(dir / "multi.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nendian: little\nencoding: gz\n\n" +
+  writeFile(dir / "multi.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nendian: little\nencoding: gz\n\n" +
                                 gzipBytes(bytes.substr(0, 40)) + gzipBytes(bytes.substr(40)));
   EXPECT_EQ(readNrrd(dir / "multi.nrrd").data, values);
 }
 
 TEST(Nrrd, ReadsAsciiAndCrLfHeaders) {
   TempDir dir;
-  spill(dir / "text.nrrd", "NRRD0004\r\ntype: float\r\ndimension: 3\r\nsizes: 2 1 1\r\nencoding: ascii\r\n\r\n1.5 -2\n");
+  writeFile(dir / "text.nrrd", "NRRD0004\r\ntype: float\r\ndimension: 3\r\nsizes: 2 1 1\r\nencoding: ascii\r\n\r\n1.5 -2\n");
   EXPECT_EQ(readNrrd(dir / "text.nrrd").data, (std::vector<float>{1.5f, -2.0f}));
 }
 
 TEST(Nrrd, HeaderOnlyReadDoesNotTouchTheData) {
   TempDir dir;
-  spill(dir / "short.nrrd", "NRRD0004\n" + kScalarHeader + "\n" + floatBytes(ramp(3)));
+  writeFile(dir / "short.nrrd", "NRRD0004\n" + kScalarHeader + "\n" + floatBytes(ramp(3)));
   EXPECT_EQ(readNrrdHeader(dir / "short.nrrd").sizes, glm::ivec3(2, 3, 4));
   expectRejected(dir / "short.nrrd", "data", "truncated");
 }
@@ -312,20 +279,20 @@ TEST(Nrrd, HeaderOnlyReadDoesNotTouchTheData) {
 
 TEST(NrrdMalformed, WrongMagic) {
   TempDir dir;
-  spill(dir / "a.nrrd", "NRRD0009\n" + kScalarHeader + "\n" + floatBytes(ramp(24)));
+  writeFile(dir / "a.nrrd", "NRRD0009\n" + kScalarHeader + "\n" + floatBytes(ramp(24)));
   expectRejected(dir / "a.nrrd", "magic", "NRRD0009");
-  spill(dir / "b.nrrd", "P6\n2 3\n255\n");
+  writeFile(dir / "b.nrrd", "P6\n2 3\n255\n");
   expectRejected(dir / "b.nrrd", "magic", "not a NRRD file");
-  spill(dir / "c.nrrd", "");
+  writeFile(dir / "c.nrrd", "");
   expectRejected(dir / "c.nrrd", "magic", "empty");
 }
 
 TEST(NrrdMalformed, TruncatedRawData) {
   TempDir dir;
-  spill(dir / "t.nrrd", "NRRD0004\n" + kScalarHeader + "\n" + floatBytes(ramp(23)));
+  writeFile(dir / "t.nrrd", "NRRD0004\n" + kScalarHeader + "\n" + floatBytes(ramp(23)));
   expectRejected(dir / "t.nrrd", "data", "truncated: sizes need 96 bytes of float32 data, found 92");
-  spill(dir / "t.raw", floatBytes(ramp(10)));
-  spill(dir / "t.nhdr", "NRRD0004\n" + kScalarHeader + "data file: t.raw\n");
+  writeFile(dir / "t.raw", floatBytes(ramp(10)));
+  writeFile(dir / "t.nhdr", "NRRD0004\n" + kScalarHeader + "data file: t.raw\n");
   expectRejected(dir / "t.nhdr", "data", (dir / "t.raw").string() + ": truncated");
 }
 
@@ -333,31 +300,31 @@ TEST(NrrdMalformed, TruncatedGzipData) {
   TempDir dir;
   std::string header = "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nendian: little\nencoding: gzip\n\n";
   std::string full = gzipBytes(floatBytes(ramp(24)));
-  spill(dir / "cut.nrrd", header + full.substr(0, full.size() / 2));
+  writeFile(dir / "cut.nrrd", header + full.substr(0, full.size() / 2));
   expectRejected(dir / "cut.nrrd", "data", "truncated");
-  spill(dir / "tail.nrrd", header + full.substr(0, full.size() - 4));  // all data, checksum trailer cut
+  writeFile(dir / "tail.nrrd", header + full.substr(0, full.size() - 4));  // all data, checksum trailer cut
   expectRejected(dir / "tail.nrrd", "data", "truncated");
-  spill(dir / "short.nrrd", header + gzipBytes(floatBytes(ramp(20))));  // complete stream, too little data
+  writeFile(dir / "short.nrrd", header + gzipBytes(floatBytes(ramp(20))));  // complete stream, too little data
   expectRejected(dir / "short.nrrd", "data", "found 80");
   std::string corrupt = full;
   corrupt[corrupt.size() / 2] ^= 0x55;
   corrupt[corrupt.size() / 2 + 1] ^= 0x55;
-  spill(dir / "corrupt.nrrd", header + corrupt);
+  writeFile(dir / "corrupt.nrrd", header + corrupt);
   expectRejected(dir / "corrupt.nrrd", "data");
 }
 
 TEST(NrrdMalformed, TooMuchData) {
   TempDir dir;
-  spill(dir / "raw.nrrd", "NRRD0004\n" + kScalarHeader + "\n" + floatBytes(ramp(25)));
+  writeFile(dir / "raw.nrrd", "NRRD0004\n" + kScalarHeader + "\n" + floatBytes(ramp(25)));
   expectRejected(dir / "raw.nrrd", "data", "4 bytes more data than sizes call for");
-  spill(dir / "gz.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nendian: little\nencoding: gzip\n\n" +
+  writeFile(dir / "gz.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nendian: little\nencoding: gzip\n\n" +
                              gzipBytes(floatBytes(ramp(30))));
   expectRejected(dir / "gz.nrrd", "data", "more data than sizes call for");
 }
 
 TEST(NrrdMalformed, SizesDisagreeWithDimension) {
   TempDir dir;
-  spill(dir / "x.ior.nrrd", "NRRD0004\ntype: float\ndimension: 4\nsizes: 3 2 2\nendian: little\nencoding: raw\n\n" +
+  writeFile(dir / "x.ior.nrrd", "NRRD0004\ntype: float\ndimension: 4\nsizes: 3 2 2\nendian: little\nencoding: raw\n\n" +
                                 floatBytes(ramp(12)));
   expectRejected(dir / "x.ior.nrrd", "sizes", "expected 4 values for dimension 4, got 3");
 }
@@ -365,7 +332,7 @@ TEST(NrrdMalformed, SizesDisagreeWithDimension) {
 TEST(NrrdMalformed, UnsupportedType) {
   TempDir dir;
   for (std::string type : {"short", "double", "unsigned char", "int8"}) {
-    spill(dir / "t.nrrd", "NRRD0004\ntype: " + type + "\ndimension: 3\nsizes: 2 3 4\nendian: little\nencoding: raw\n\n" +
+    writeFile(dir / "t.nrrd", "NRRD0004\ntype: " + type + "\ndimension: 3\nsizes: 2 3 4\nendian: little\nencoding: raw\n\n" +
                               floatBytes(ramp(48)));
     expectRejected(dir / "t.nrrd", "type", type);
   }
@@ -374,7 +341,7 @@ TEST(NrrdMalformed, UnsupportedType) {
 TEST(NrrdMalformed, UnsupportedEncoding) {
   TempDir dir;
   for (std::string encoding : {"hex", "bzip2", "lz4"}) {
-    spill(dir / "e.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nendian: little\nencoding: " + encoding +
+    writeFile(dir / "e.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nendian: little\nencoding: " + encoding +
                               "\n\n" + floatBytes(ramp(24)));
     expectRejected(dir / "e.nrrd", "encoding", encoding);
   }
@@ -384,22 +351,22 @@ TEST(NrrdMalformed, NonFiniteSamples) {
   TempDir dir;
   std::vector<float> values = ramp(24);
   values[7] = std::numeric_limits<float>::quiet_NaN();
-  spill(dir / "nan.nrrd", "NRRD0004\n" + kScalarHeader + "\n" + floatBytes(values));
+  writeFile(dir / "nan.nrrd", "NRRD0004\n" + kScalarHeader + "\n" + floatBytes(values));
   expectRejected(dir / "nan.nrrd", "data", "NaN at voxel (1, 0, 1)");
 
   values = ramp(48);
   values[5] = -std::numeric_limits<float>::infinity();
-  spill(dir / "inf.nrrd", "NRRD0004\ntype: float\ndimension: 4\nsizes: 2 2 3 4\nendian: little\nencoding: gzip\n\n" +
+  writeFile(dir / "inf.nrrd", "NRRD0004\ntype: float\ndimension: 4\nsizes: 2 2 3 4\nendian: little\nencoding: gzip\n\n" +
                               gzipBytes(floatBytes(values)));
   expectRejected(dir / "inf.nrrd", "data", "-Inf at voxel (0, 1, 0) component 1");
 }
 
 TEST(NrrdMalformed, SizesOverTheAxisLimitFailBeforeReading) {
   TempDir dir;
-  spill(dir / "big.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2048 2 2\nendian: little\nencoding: raw\n\n" +
+  writeFile(dir / "big.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2048 2 2\nendian: little\nencoding: raw\n\n" +
                               floatBytes(ramp(4)));
   expectRejected(dir / "big.nrrd", "sizes", "2048 voxels along x exceeds the limit of 1024");
-  spill(dir / "huge.nrrd",
+  writeFile(dir / "huge.nrrd",
         "NRRD0004\ntype: float\ndimension: 3\nsizes: 8 8 99999999999999999\nendian: little\nencoding: raw\n\n");
   expectRejected(dir / "huge.nrrd", "sizes");
   EXPECT_THROW(readNrrdHeader(dir / "big.nrrd"), InputError);
@@ -428,7 +395,7 @@ class ScopedEnv {
 TEST(NrrdMalformed, SizesOverTheMemoryLimitFailBeforeAllocating) {
   TempDir dir;
   // 3 × 512³ floats = 1.5 GiB against a pretend machine of 64 MiB; only a header and 8 bytes are on disk.
-  spill(dir / "mem.nrrd", "NRRD0004\ntype: float\ndimension: 4\nsizes: 3 512 512 512\nendian: little\nencoding: raw\n\n" +
+  writeFile(dir / "mem.nrrd", "NRRD0004\ntype: float\ndimension: 4\nsizes: 3 512 512 512\nendian: little\nencoding: raw\n\n" +
                               floatBytes(ramp(2)));
   ScopedEnv limit("EIKONAL_MEMORY_LIMIT_BYTES", "67108864");
   expectRejected(dir / "mem.nrrd", "sizes", "needs 1.5 GiB of memory, more than the 64.0 MiB");
@@ -437,50 +404,50 @@ TEST(NrrdMalformed, SizesOverTheMemoryLimitFailBeforeAllocating) {
 TEST(NrrdMalformed, MissingRequiredFields) {
   TempDir dir;
   const std::string data = "\n" + floatBytes(ramp(24));
-  spill(dir / "1.nrrd", "NRRD0004\ndimension: 3\nsizes: 2 3 4\nendian: little\nencoding: raw\n" + data);
+  writeFile(dir / "1.nrrd", "NRRD0004\ndimension: 3\nsizes: 2 3 4\nendian: little\nencoding: raw\n" + data);
   expectRejected(dir / "1.nrrd", "type", "missing");
-  spill(dir / "2.nrrd", "NRRD0004\ntype: float\nsizes: 2 3 4\nendian: little\nencoding: raw\n" + data);
+  writeFile(dir / "2.nrrd", "NRRD0004\ntype: float\nsizes: 2 3 4\nendian: little\nencoding: raw\n" + data);
   expectRejected(dir / "2.nrrd", "dimension", "missing");
-  spill(dir / "3.nrrd", "NRRD0004\ntype: float\ndimension: 3\nendian: little\nencoding: raw\n" + data);
+  writeFile(dir / "3.nrrd", "NRRD0004\ntype: float\ndimension: 3\nendian: little\nencoding: raw\n" + data);
   expectRejected(dir / "3.nrrd", "sizes", "missing");
-  spill(dir / "4.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nendian: little\n" + data);
+  writeFile(dir / "4.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nendian: little\n" + data);
   expectRejected(dir / "4.nrrd", "encoding", "missing");
-  spill(dir / "5.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nencoding: raw\n" + data);
+  writeFile(dir / "5.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nencoding: raw\n" + data);
   expectRejected(dir / "5.nrrd", "endian", "missing");
 }
 
 TEST(NrrdMalformed, DetachedDataFile) {
   TempDir dir;
-  spill(dir / "gone.nhdr", "NRRD0004\n" + kScalarHeader + "data file: gone.raw\n");
+  writeFile(dir / "gone.nhdr", "NRRD0004\n" + kScalarHeader + "data file: gone.raw\n");
   expectRejected(dir / "gone.nhdr", "data file", (dir / "gone.raw").string() + ": not found");
   EXPECT_THROW(readNrrdHeader(dir / "gone.nhdr"), InputError);
-  spill(dir / "none.nhdr", "NRRD0004\n" + kScalarHeader);
+  writeFile(dir / "none.nhdr", "NRRD0004\n" + kScalarHeader);
   expectRejected(dir / "none.nhdr", "data file", "missing");
-  spill(dir / "list.nhdr", "NRRD0004\n" + kScalarHeader + "data file: LIST\na.raw\n");
+  writeFile(dir / "list.nhdr", "NRRD0004\n" + kScalarHeader + "data file: LIST\na.raw\n");
   expectRejected(dir / "list.nhdr", "data file", "multi-file");
 }
 
 TEST(NrrdMalformed, DimensionAndComponents) {
   TempDir dir;
-  spill(dir / "d2.nrrd", "NRRD0004\ntype: float\ndimension: 2\nsizes: 4 6\nendian: little\nencoding: raw\n\n" +
+  writeFile(dir / "d2.nrrd", "NRRD0004\ntype: float\ndimension: 2\nsizes: 4 6\nendian: little\nencoding: raw\n\n" +
                              floatBytes(ramp(24)));
   expectRejected(dir / "d2.nrrd", "dimension", "2 is not supported");
-  spill(dir / "d5.nrrd", "NRRD0004\ntype: float\ndimension: 5\nsizes: 1 2 1 3 4\nendian: little\nencoding: raw\n\n" +
+  writeFile(dir / "d5.nrrd", "NRRD0004\ntype: float\ndimension: 5\nsizes: 1 2 1 3 4\nendian: little\nencoding: raw\n\n" +
                              floatBytes(ramp(24)));
   expectRejected(dir / "d5.nrrd", "dimension", "5 is not supported");
-  spill(dir / "c5.nrrd", "NRRD0004\ntype: float\ndimension: 4\nsizes: 5 2 3 4\nendian: little\nencoding: raw\n\n" +
+  writeFile(dir / "c5.nrrd", "NRRD0004\ntype: float\ndimension: 4\nsizes: 5 2 3 4\nendian: little\nencoding: raw\n\n" +
                              floatBytes(ramp(120)));
   expectRejected(dir / "c5.nrrd", "sizes", "component axis (the first) has 5 values; expected 1 to 4");
-  spill(dir / "k.nrrd", "NRRD0004\ntype: float\ndimension: 4\nsizes: 2 2 3 4\nkinds: 3-vector domain domain domain\n"
+  writeFile(dir / "k.nrrd", "NRRD0004\ntype: float\ndimension: 4\nsizes: 2 2 3 4\nkinds: 3-vector domain domain domain\n"
                         "endian: little\nencoding: raw\n\n" + floatBytes(ramp(48)));
   expectRejected(dir / "k.nrrd", "kinds", "3-vector");
-  spill(dir / "k4.nrrd", "NRRD0004\ntype: float\ndimension: 4\nsizes: 2 2 3 4\nkinds: domain domain domain domain\n"
+  writeFile(dir / "k4.nrrd", "NRRD0004\ntype: float\ndimension: 4\nsizes: 2 2 3 4\nkinds: domain domain domain domain\n"
                          "endian: little\nencoding: raw\n\n" + floatBytes(ramp(48)));
   expectRejected(dir / "k4.nrrd", "kinds", "4-dimensional domains");
-  spill(dir / "last.nrrd", "NRRD0004\ntype: float\ndimension: 4\nsizes: 2 3 4 2\nkinds: domain domain domain vector\n"
+  writeFile(dir / "last.nrrd", "NRRD0004\ntype: float\ndimension: 4\nsizes: 2 3 4 2\nkinds: domain domain domain vector\n"
                            "endian: little\nencoding: raw\n\n" + floatBytes(ramp(48)));
   expectRejected(dir / "last.nrrd", "kinds");
-  spill(dir / "dir.nrrd", "NRRD0004\ntype: float\ndimension: 4\nsizes: 2 2 3 4\nspace: RAS\n"
+  writeFile(dir / "dir.nrrd", "NRRD0004\ntype: float\ndimension: 4\nsizes: 2 2 3 4\nspace: RAS\n"
                           "space directions: (1,0,0) (1,0,0) (0,1,0) (0,0,1)\nendian: little\nencoding: raw\n\n" +
                               floatBytes(ramp(48)));
   expectRejected(dir / "dir.nrrd", "space directions", "must be 'none'");
@@ -489,28 +456,28 @@ TEST(NrrdMalformed, DimensionAndComponents) {
 TEST(NrrdMalformed, NonNumericNumbers) {
   TempDir dir;
   const std::string data = "\n" + floatBytes(ramp(24));
-  spill(dir / "a.nrrd", "NRRD0004\ntype: float\ndimension: three\nsizes: 2 3 4\nendian: little\nencoding: raw\n" + data);
+  writeFile(dir / "a.nrrd", "NRRD0004\ntype: float\ndimension: three\nsizes: 2 3 4\nendian: little\nencoding: raw\n" + data);
   expectRejected(dir / "a.nrrd", "dimension", "'three' is not an integer");
-  spill(dir / "b.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 x 4\nendian: little\nencoding: raw\n" + data);
+  writeFile(dir / "b.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 x 4\nendian: little\nencoding: raw\n" + data);
   expectRejected(dir / "b.nrrd", "sizes", "'x' is not an integer");
-  spill(dir / "c.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4.5\nendian: little\nencoding: raw\n" + data);
+  writeFile(dir / "c.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4.5\nendian: little\nencoding: raw\n" + data);
   expectRejected(dir / "c.nrrd", "sizes", "'4.5' is not an integer");
-  spill(dir / "d.nrrd", "NRRD0004\n" + kScalarHeader + "space: RAS\nspace origin: (0,abc,0)\n" + data);
+  writeFile(dir / "d.nrrd", "NRRD0004\n" + kScalarHeader + "space: RAS\nspace origin: (0,abc,0)\n" + data);
   expectRejected(dir / "d.nrrd", "space origin", "'abc'");
-  spill(dir / "e.nrrd", "NRRD0004\n" + kScalarHeader + "space: RAS\nspace directions: (1,0,0) (0,1e,0) (0,0,1)\n" + data);
+  writeFile(dir / "e.nrrd", "NRRD0004\n" + kScalarHeader + "space: RAS\nspace directions: (1,0,0) (0,1e,0) (0,0,1)\n" + data);
   expectRejected(dir / "e.nrrd", "space directions", "'1e'");
-  spill(dir / "f.nrrd", "NRRD0004\n" + kScalarHeader + "spacings: 1 one 1\n" + data);
+  writeFile(dir / "f.nrrd", "NRRD0004\n" + kScalarHeader + "spacings: 1 one 1\n" + data);
   expectRejected(dir / "f.nrrd", "spacings", "'one' is not a number");
-  spill(dir / "g.nrrd", "NRRD0004\n" + kScalarHeader + "byte skip: some\n" + data);
+  writeFile(dir / "g.nrrd", "NRRD0004\n" + kScalarHeader + "byte skip: some\n" + data);
   expectRejected(dir / "g.nrrd", "byte skip", "not an integer");
-  spill(dir / "h.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 1 1\nencoding: ascii\n\n1.5 pi\n");
+  writeFile(dir / "h.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 1 1\nencoding: ascii\n\n1.5 pi\n");
   expectRejected(dir / "h.nrrd", "data", "'pi' is not a number");
 }
 
 TEST(NrrdMalformed, NonPositiveSizes) {
   TempDir dir;
   for (std::string sizes : {"2 0 4", "2 -3 4"}) {
-    spill(dir / "s.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: " + sizes +
+    writeFile(dir / "s.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: " + sizes +
                               "\nendian: little\nencoding: raw\n\n" + floatBytes(ramp(24)));
     expectRejected(dir / "s.nrrd", "sizes", "must be positive");
   }
@@ -519,19 +486,19 @@ TEST(NrrdMalformed, NonPositiveSizes) {
 TEST(NrrdMalformed, OtherHeaderErrors) {
   TempDir dir;
   const std::string data = "\n" + floatBytes(ramp(24));
-  spill(dir / "skip.nrrd", "NRRD0004\n" + kScalarHeader + "byte skip: -1\n" + data);
+  writeFile(dir / "skip.nrrd", "NRRD0004\n" + kScalarHeader + "byte skip: -1\n" + data);
   expectRejected(dir / "skip.nrrd", "byte skip", "-1");
-  spill(dir / "space.nrrd", "NRRD0004\n" + kScalarHeader + "space: right-anterior-superior-time\n" + data);
+  writeFile(dir / "space.nrrd", "NRRD0004\n" + kScalarHeader + "space: right-anterior-superior-time\n" + data);
   expectRejected(dir / "space.nrrd", "space", "not supported");
-  spill(dir / "twice.nrrd", "NRRD0004\n" + kScalarHeader + "encoding: gzip\n" + data);
+  writeFile(dir / "twice.nrrd", "NRRD0004\n" + kScalarHeader + "encoding: gzip\n" + data);
   expectRejected(dir / "twice.nrrd", "encoding", "given twice");
-  spill(dir / "endian.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nendian: middle\nencoding: raw\n" + data);
+  writeFile(dir / "endian.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nendian: middle\nencoding: raw\n" + data);
   expectRejected(dir / "endian.nrrd", "endian", "'middle'");
-  spill(dir / "junk.nrrd", "NRRD0004\n" + kScalarHeader + "this line is junk\n" + data);
+  writeFile(dir / "junk.nrrd", "NRRD0004\n" + kScalarHeader + "this line is junk\n" + data);
   expectRejected(dir / "junk.nrrd", "header", "line 7");
-  spill(dir / "flat.nrrd", "NRRD0004\n" + kScalarHeader + "space: RAS\nspace directions: (1,0,0) (2,0,0) (0,0,1)\n" + data);
+  writeFile(dir / "flat.nrrd", "NRRD0004\n" + kScalarHeader + "space: RAS\nspace directions: (1,0,0) (2,0,0) (0,0,1)\n" + data);
   expectRejected(dir / "flat.nrrd", "space directions", "linearly dependent");
-  spill(dir / "vec.nrrd", "NRRD0004\n" + kScalarHeader + "space: RAS\nspace origin: (1,2)\n" + data);
+  writeFile(dir / "vec.nrrd", "NRRD0004\n" + kScalarHeader + "space: RAS\nspace origin: (1,2)\n" + data);
   expectRejected(dir / "vec.nrrd", "space origin", "2 components");
 }
 

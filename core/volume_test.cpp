@@ -1,61 +1,26 @@
 #include "core/volume.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <random>
-#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "core/error.h"
 #include "core/nrrd.h"
+#include "core/testing.h"
 
 namespace eik {
 namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-class TempDir {
- public:
-  TempDir() {
-    std::random_device random;
-    path_ = fs::temp_directory_path() / ("eikonal-volume-" + std::to_string(::getpid()) + "-" + std::to_string(random()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-  std::vector<std::string> entries() const {
-    std::vector<std::string> names;
-    for (const auto& entry : fs::directory_iterator(path_)) names.push_back(entry.path().filename().string());
-    std::sort(names.begin(), names.end());
-    return names;
-  }
-
- private:
-  fs::path path_;
-};
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-void spill(const fs::path& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out << bytes;
-}
+using test_support::readFile;
+using test_support::TempDir;
+using test_support::writeFile;
 
 template <typename Body>
 std::string inputErrorOf(Body&& body) {
@@ -107,10 +72,10 @@ void expectSameVolume(const Volume& a, const Volume& b) {
 // Writes the sample volume as DIR/scene.vol.json and returns the manifest's JSON for editing.
 json writeSample(const TempDir& dir, const VolumeWriteOptions& options = {}) {
   writeVolume(sampleVolume(), dir / "scene.vol.json", options);
-  return json::parse(slurp(dir / "scene.vol.json"));
+  return json::parse(readFile(dir / "scene.vol.json"));
 }
 
-void rewriteManifest(const TempDir& dir, const json& manifest) { spill(dir / "scene.vol.json", manifest.dump(2)); }
+void rewriteManifest(const TempDir& dir, const json& manifest) { writeFile(dir / "scene.vol.json", manifest.dump(2)); }
 
 std::string manifestError(const TempDir& dir) {
   return inputErrorOf([&] { readVolume(dir / "scene.vol.json"); });
@@ -180,10 +145,10 @@ TEST_P(VolumeRoundTrip, IsBitExact) {
   EXPECT_EQ(dir.entries(), expected);
 
   // Writing the read-back volume again reproduces the manifest.
-  std::string first = slurp(dir / "scene.vol.json");
+  std::string first = readFile(dir / "scene.vol.json");
   TempDir again;
   writeVolume(back, again / "scene.vol.json", GetParam());
-  EXPECT_EQ(slurp(again / "scene.vol.json"), first);
+  EXPECT_EQ(readFile(again / "scene.vol.json"), first);
 }
 
 INSTANTIATE_TEST_SUITE_P(Encodings, VolumeRoundTrip,
@@ -205,7 +170,7 @@ TEST(Volume, ManifestLayout) {
   EXPECT_EQ(manifest.at("fields").at("ior"), json({{"file", "scene.ior.nrrd"}, {"components", 1}}));
   EXPECT_EQ(manifest.at("fields").at("sigma_a"), json({{"file", "scene.sigma_a.nrrd"}, {"components", 3}}));
   EXPECT_EQ(manifest.at("light").at("type"), "directional");
-  std::string text = slurp(dir / "scene.vol.json");
+  std::string text = readFile(dir / "scene.vol.json");
   EXPECT_EQ(text.rfind("{\n  \"format\": \"eikonal-volume\",\n  \"version\": 1,", 0), 0u) << text;
 
   // The NRRD sits on the grid: origin = centre of voxel 0, directions = diag(voxel size).
@@ -328,12 +293,12 @@ TEST(VolumeMalformed, BoundsDisagreeWithNrrdGeometry) {
 TEST(VolumeMalformed, JsonSyntaxAndStructure) {
   TempDir dir;
   writeSample(dir);
-  spill(dir / "scene.vol.json", "{\n  \"format\": \"eikonal-volume\",\n  \"dims\": [8, 6, 4\n}\n");
+  writeFile(dir / "scene.vol.json", "{\n  \"format\": \"eikonal-volume\",\n  \"dims\": [8, 6, 4\n}\n");
   std::string message = manifestError(dir);
   EXPECT_CONTAINS(message, (dir / "scene.vol.json").string() + ": JSON: ");
   EXPECT_CONTAINS(message, "line 4");
 
-  spill(dir / "scene.vol.json", "[1, 2, 3]");
+  writeFile(dir / "scene.vol.json", "[1, 2, 3]");
   EXPECT_CONTAINS(manifestError(dir), "scene.vol.json: JSON: expected an object");
 
   json manifest = writeSample(dir);
@@ -369,8 +334,8 @@ TEST(VolumeMalformed, NrrdErrorsNameTheManifestFieldAndFile) {
   TempDir dir;
   writeSample(dir, {false, false});
   fs::path nrrd = dir / "scene.scatter.nrrd";
-  std::string bytes = slurp(nrrd);
-  spill(nrrd, bytes.substr(0, bytes.size() - 8));
+  std::string bytes = readFile(nrrd);
+  writeFile(nrrd, bytes.substr(0, bytes.size() - 8));
   std::string message = manifestError(dir);
   EXPECT_CONTAINS(message, (dir / "scene.vol.json").string() + ": fields.scatter: " + nrrd.string() + ": data: truncated");
 }
@@ -406,23 +371,23 @@ TEST(VolumeWrite, FailedRewriteKeepsTheOldVolume) {
   TempDir dir;
   writeSample(dir, {true, true});
   std::vector<std::string> before = dir.entries();
-  std::string manifest = slurp(dir / "scene.vol.json");
-  std::string ior = slurp(dir / "scene.ior.raw.gz");
+  std::string manifest = readFile(dir / "scene.vol.json");
+  std::string ior = readFile(dir / "scene.ior.raw.gz");
 
   Volume volume = sampleVolume();
   volume.fields.at("ior").data.assign(volume.fields.at("ior").data.size(), 1.5f);
   volume.fields.at("sigma_a").data[0] = std::numeric_limits<float>::infinity();
   EXPECT_THROW(writeVolume(volume, dir / "scene.vol.json", {true, true}), RuntimeError);
   EXPECT_EQ(dir.entries(), before);
-  EXPECT_EQ(slurp(dir / "scene.vol.json"), manifest);
-  EXPECT_EQ(slurp(dir / "scene.ior.raw.gz"), ior);
+  EXPECT_EQ(readFile(dir / "scene.vol.json"), manifest);
+  EXPECT_EQ(readFile(dir / "scene.ior.raw.gz"), ior);
 }
 
 TEST(VolumeWrite, UnwritableDestinationLeavesNoFiles) {
   TempDir dir;
   std::string message = inputErrorOf([&] { writeVolume(sampleVolume(), dir / "missing" / "scene.vol.json"); });
   EXPECT_CONTAINS(message, "does not exist");
-  spill(dir / "file", "not a directory");
+  writeFile(dir / "file", "not a directory");
   EXPECT_ANY_THROW(writeVolume(sampleVolume(), dir / "file" / "scene.vol.json"));
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"file"});
 }

@@ -78,6 +78,12 @@ std::string_view glBackendName(GlBackend backend) {
   return "?";
 }
 
+bool displayAvailable() {
+  const char* x11 = std::getenv("DISPLAY");
+  const char* wayland = std::getenv("WAYLAND_DISPLAY");
+  return (x11 && *x11) || (wayland && *wayland);
+}
+
 GlBackend glBackendFromEnvironment(GlBackend fallback) {
   const char* value = std::getenv("EIKONAL_GL");
   if (!value || !*value) return fallback;
@@ -110,8 +116,6 @@ GlContext::GlContext(const ContextOptions& options) {
 
   t_loadedFrom = nullptr;  // a new context: always load its own entry points
   loadFunctions(backend_->loader(), backendName);
-  t_current = this;
-  setErrorChecksEnabled(debug_);
 
   info_.backend = backend_->kind();
   info_.platform = backend_->platform();
@@ -124,7 +128,7 @@ GlContext::GlContext(const ContextOptions& options) {
   info_.coreProfile = (getInt(GL_CONTEXT_PROFILE_MASK) & GL_CONTEXT_CORE_PROFILE_BIT) != 0;
   if (info_.major * 10 + info_.minor < 33 || !info_.coreProfile) {
     std::string got = info_.version + (info_.coreProfile ? "" : ", not a core profile");
-    t_current = nullptr;
+    t_current = nullptr;  // the failed context replaced whatever was current
     backend_->releaseCurrent();
     throw RuntimeError("could not create an OpenGL 3.3 core context " + backendName + ": got OpenGL " + got +
                        " from " + info_.renderer);
@@ -143,6 +147,8 @@ GlContext::GlContext(const ContextOptions& options) {
   while (glGetError() != GL_NO_ERROR) {
   }
   if (debug_) info_.debugOutput = installDebugCallback();
+  t_current = this;
+  setErrorChecksEnabled(debug_);
 }
 
 GlContext::~GlContext() {

@@ -5,7 +5,8 @@
 //           dropped OSMesa.
 //   Window  a GLFW window (X11/Wayland), visible or hidden, for the interactive viewer.
 // Every back end asks for 3.3 core and accepts anything newer (Mesa gives 4.5). Creating a context
-// makes it current and loads glad's function pointers from that context's own getProcAddress.
+// makes it current and loads glad's function pointers from that context's own getProcAddress
+// (when creation fails, no GlContext is current afterwards).
 //
 // Headless contexts have no usable default framebuffer: render into a gl::Framebuffer.
 // GL objects (gl/texture.h, ...) must be destroyed while their context is current and before it;
@@ -31,6 +32,9 @@ GlBackend parseGlBackend(std::string_view text, std::string_view source = "--gl"
 std::string_view glBackendName(GlBackend backend);
 // The back end EIKONAL_GL names, or `fallback` when it is unset or empty.
 GlBackend glBackendFromEnvironment(GlBackend fallback = GlBackend::Auto);
+// Whether a window can be opened at all (DISPLAY or WAYLAND_DISPLAY is set): the viewer opens a
+// Window when this holds and nothing else was asked for, else renders headless.
+bool displayAvailable();
 
 struct ContextOptions {
   // Auto: EIKONAL_GL when set, else headless: OSMesa, then EGL if OSMesa fails.

@@ -156,9 +156,7 @@ TEST(GlContextTest, NoChecksWithoutDebug) {
 
 TEST(GlfwWindow, RendersPatternAndDefaultFramebuffer) {
   const bool required = std::getenv("EIKONAL_REQUIRE_DISPLAY") != nullptr;
-  const char* display = std::getenv("DISPLAY");
-  const char* wayland = std::getenv("WAYLAND_DISPLAY");
-  if (!(display && *display) && !(wayland && *wayland)) {
+  if (!displayAvailable()) {
     if (required) FAIL() << "EIKONAL_REQUIRE_DISPLAY is set but there is no DISPLAY";
     GTEST_SKIP() << "no DISPLAY (ctest runs this test under xvfb-run as gl_tests.GlfwWindowUnderXvfb)";
   }

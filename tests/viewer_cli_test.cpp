@@ -54,9 +54,9 @@ TEST(ViewerCli, BadInputExitsTwo) {
     std::vector<std::string> args;
     const char* expected;
   };
-  writeText(dir / "unknown_key.json", R"({"objects": [{"volume": "ball.vol.json"}], "camera": {"fov": 40}})");
-  writeText(dir / "wrong_type.json", R"({"objects": [{"volume": "ball.vol.json", "scale": "big"}]})");
-  writeText(dir / "no_volume.json", R"({"objects": [{"volume": "missing.vol.json"}]})");
+  writeFile(dir / "unknown_key.json", R"({"objects": [{"volume": "ball.vol.json"}], "camera": {"fov": 40}})");
+  writeFile(dir / "wrong_type.json", R"({"objects": [{"volume": "ball.vol.json", "scale": "big"}]})");
+  writeFile(dir / "no_volume.json", R"({"objects": [{"volume": "missing.vol.json"}]})");
   // A volume without ior_grad.
   Volume v = readVolume(dir / "ball.vol.json");
   v.fields.erase("ior_grad");

@@ -104,7 +104,7 @@ TEST(VoxelizeCli, ProceduralSphereWritesAVolumeAndStats) {
   Volume v = readVolume(dir / "ball.vol.json");
   EXPECT_TRUE(v.has("ior") && v.has("ior_grad") && v.has("sigma_a"));
   EXPECT_EQ(v.grid.dims.x, 32 + 2 * 3);  // --res on the longest axis plus 3 voxels of padding per side
-  json stats = json::parse(readText(dir / "stats.json"));
+  json stats = json::parse(readFile(dir / "stats.json"));
   EXPECT_GT(stats["time_total_s"].get<double>(), 0.0);
   EXPECT_EQ(stats["voxels"].get<std::size_t>(), v.grid.count());
   EXPECT_GT(stats["peak_memory_mib"].get<double>(), 1.0);
@@ -115,10 +115,10 @@ TEST(VoxelizeCli, ProceduralSphereWritesAVolumeAndStats) {
 
 TEST(VoxelizeCli, GltfLightsAndCamerasGoIntoASceneFile) {
   TempDir dir;
-  writeText(dir / "cube.gltf", cubeGltf());
+  writeFile(dir / "cube.gltf", cubeGltf());
   ProgramResult r = voxelize(dir, {"cube.gltf", "-o", "cube.vol.json", "--res", "24"});
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  json scene = json::parse(readText(dir / "cube.scene.json"));
+  json scene = json::parse(readFile(dir / "cube.scene.json"));
   ASSERT_EQ(scene["lights"].size(), 1u);
   const json& light = scene["lights"][0];
   EXPECT_EQ(light["type"], "directional");
@@ -141,7 +141,7 @@ TEST(VoxelizeCli, GltfLightsAndCamerasGoIntoASceneFile) {
 
 TEST(VoxelizeCli, MaterialOverridesObjAndProceduralInputs) {
   TempDir dir;
-  writeText(dir / "tet.obj",
+  writeFile(dir / "tet.obj",
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
   ProgramResult r = voxelize(dir, {"tet.obj", "--material", "ior=1.7,sigma_a=0.1:0.2:0.3", "-o", "t.vol.json", "--res", "24"});
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -172,12 +172,12 @@ class VoxelizeBadInput : public ::testing::TestWithParam<BadCase> {};
 TEST_P(VoxelizeBadInput, ExitsTwoNamingTheProblemAndWritesNothing) {
   const BadCase& c = GetParam();
   TempDir dir;
-  if (c.file_name) writeText(dir / c.file_name, c.file_content);
-  const auto before = dir.files();
+  if (c.file_name) writeFile(dir / c.file_name, c.file_content);
+  const auto before = dir.entries();
   ProgramResult r = voxelize(dir, c.args);
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find(c.expected), std::string::npos) << "expected '" << c.expected << "' in: " << r.output;
-  EXPECT_EQ(dir.files(), before) << "a failed run left files behind";
+  EXPECT_EQ(dir.entries(), before) << "a failed run left files behind";
   EXPECT_EQ(r.output.find("terminate"), std::string::npos) << r.output;
 }
 

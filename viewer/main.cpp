@@ -11,9 +11,9 @@
 #include <sstream>
 #include <string>
 
-#include <CLI/CLI.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "core/cli.h"
 #include "core/error.h"
 #include "core/image_io.h"
 #include "core/scene.h"
@@ -65,7 +65,7 @@ glm::dmat4 objectToWorld(const SceneObjectSpec& o) {
 }
 
 int run(int argc, char** argv) {
-  std::string input, output, size_text, camera_text, env_text, tonemap_text = "aces", gl_backend = "auto";
+  std::string input, output, size_text, camera_text, env_text, tonemap_text, gl_backend = "auto";
   double step = 0.5, exposure = 0.0;
   bool quiet = false;
   CLI::App app{"viewer: render refractive volumes along curved rays (thesis §5, §6.3)", "viewer"};
@@ -74,24 +74,16 @@ int run(int argc, char** argv) {
   app.add_option("--size", size_text, "image size WxH (default: the scene's render.size, else 512x512)");
   app.add_option("--camera", camera_text, "EX,EY,EZ:TX,TY,TZ:FOVY_DEG (default: the scene's camera, or framing the volume)");
   app.add_option("--env", env_text, "uniform:R,G,B or checker:R,G,B (default: the scene's uniform environment, else white)");
-  app.add_option("--step", step, "ray step in voxels (default 0.5)")->check(CLI::Range(0.01, 4.0));
-  app.add_option("--exposure", exposure, "exposure in EV for PNG output (default 0)");
-  app.add_option("--tonemap", tonemap_text, "aces | reinhard | linear, for PNG output (default aces)");
+  app.add_option("--step", step, "ray step in voxels (default: the scene's render.step_voxels, else 0.5)")->check(CLI::Range(0.01, 4.0));
+  app.add_option("--exposure", exposure, "exposure in EV for PNG output (default: the scene's render.exposure, else 0)");
+  app.add_option("--tonemap", tonemap_text, "aces | reinhard | linear, for PNG output (default: the scene's render.tonemap, else aces)");
   app.add_option("--gl", gl_backend, "OpenGL back end: auto | osmesa | egl (default auto: OSMesa, then EGL)");
   app.add_flag("-q,--quiet", quiet, "print nothing but errors");
   app.footer("Exit codes: 0 success, 1 runtime failure, 2 bad usage or bad input.");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp&) {
-    std::printf("%s", app.help().c_str());
-    return kExitOk;
-  } catch (const CLI::ParseError& e) {
-    throw InputError(std::string("command line: ") + e.what() + " (see viewer --help)");
-  }
+  if (!parseCommandLine(app, argc, argv)) return kExitOk;
   if (output.empty())
     throw InputError("command line", "--render",
                      "the interactive window is not built yet: give --render OUT.png (or OUT.exr)");
-  const ToneMapper tonemap = parseToneMapper(tonemap_text);
   {
     std::string ext = fs::path(output).extension().string();
     if (ext != ".png" && ext != ".exr") throw InputError("--render", output, "the output must end in .png or .exr");
@@ -114,6 +106,8 @@ int run(int argc, char** argv) {
     volume_path = input;
     scene.objects.push_back(SceneObjectSpec{input});
   }
+  const ToneMapper tonemap =
+      parseToneMapper(!tonemap_text.empty() ? tonemap_text : is_scene ? scene.render.tonemap : "aces");
   Volume volume = readVolume(volume_path);
   volume.require("ior", 1, volume_path.string());
   volume.require("ior_grad", 3, volume_path.string());
@@ -132,7 +126,7 @@ int run(int argc, char** argv) {
   glm::ivec2 size = size_text.empty() ? (is_scene ? scene.render.size : glm::ivec2(512, 512)) : parseSize(size_text);
 
   RenderSettings settings;
-  settings.step_voxels = is_scene && step == 0.5 ? scene.render.step_voxels : step;
+  settings.step_voxels = is_scene && app.count("--step") == 0 ? scene.render.step_voxels : step;
   if (!env_text.empty())
     parseEnvironment(env_text, settings);
   else if (is_scene && scene.environment.uniform)
@@ -145,7 +139,7 @@ int run(int argc, char** argv) {
   RefractiveRenderer renderer(shaders, volume, settings, volume_path.string());
   Image image = renderer.render(camera, size, objectToWorld(scene.objects[0]));
   ImageWriteOptions write;
-  write.exposure_ev = static_cast<float>(is_scene && exposure == 0.0 ? scene.render.exposure : exposure);
+  write.exposure_ev = static_cast<float>(is_scene && app.count("--exposure") == 0 ? scene.render.exposure : exposure);
   write.tonemap = tonemap;
   writeImage(output, image, write);
   if (!quiet) std::fprintf(stderr, "viewer: wrote %s (%dx%d) with %s\n", output.c_str(), size.x, size.y, context.summary().c_str());

@@ -8,14 +8,15 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/testing.h"
 #include "voxelize/mesh_scene.h"
 #include "voxelize/test_meshes.h"
 
@@ -23,6 +24,10 @@ namespace eik {
 namespace {
 
 using nlohmann::json;
+
+std::string_view asChars(const std::vector<unsigned char>& bytes) {
+  return {reinterpret_cast<const char*>(bytes.data()), bytes.size()};
+}
 
 std::string base64(const std::vector<unsigned char>& data) {
   static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -97,9 +102,8 @@ class GltfBuilder {
   void writeExternal(const std::filesystem::path& gltf, const std::string& bin_name) const {
     json d = doc;
     d["buffers"] = json::array({{{"byteLength", bin.size()}, {"uri", bin_name}}});
-    std::ofstream(gltf) << d.dump();
-    std::ofstream out(gltf.parent_path() / bin_name, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bin.data()), static_cast<std::streamsize>(bin.size()));
+    test_support::writeFile(gltf, d.dump());
+    test_support::writeFile(gltf.parent_path() / bin_name, asChars(bin));
   }
   std::vector<unsigned char> glb() const {
     json d = doc;
@@ -127,23 +131,14 @@ class GltfBuilder {
 
 class GltfLoader : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("eikonal_gltf_test_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    std::filesystem::remove_all(dir_);
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-
   std::filesystem::path write(const std::string& name, const std::string& text) {
     const auto path = dir_ / name;
-    std::ofstream(path, std::ios::binary) << text;
+    test_support::writeFile(path, text);
     return path;
   }
   std::filesystem::path writeBytes(const std::string& name, const std::vector<unsigned char>& bytes) {
     const auto path = dir_ / name;
-    std::ofstream out(path, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    test_support::writeFile(path, asChars(bytes));
     return path;
   }
   // Expects an InputError whose message names the file and contains every one of `parts`.
@@ -158,7 +153,7 @@ class GltfLoader : public ::testing::Test {
     }
   }
 
-  std::filesystem::path dir_;
+  test_support::TempDir dir_{"eikonal-gltf"};
 };
 
 // A closed tetrahedron (0,0,0), (1,0,0), (0,1,0), (0,0,1) as float VEC3 + uint16 indices, base64.

@@ -14,10 +14,10 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
+#include "core/cli.h"
 #include "core/error.h"
 #include "core/progress.h"
 #include "core/scene.h"
@@ -140,14 +140,7 @@ int run(int argc, char** argv) {
       "  voxelize glass.glb -o glass.vol.json --res 256\n"
       "  voxelize bunny.obj --material ior=1.55,sigma_a=0.2:0.6:1.4 -o bunny.vol.json\n"
       "Exit codes: 0 success, 1 runtime failure, 2 bad usage or bad input.");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp&) {
-    std::printf("%s", app.help().c_str());
-    return kExitOk;
-  } catch (const CLI::ParseError& e) {
-    throw InputError(std::string("command line: ") + e.what() + " (see voxelize --help)");
-  }
+  if (!parseCommandLine(app, argc, argv)) return kExitOk;
   if (o.list_shapes) {
     std::printf("%s", shapeHelp().c_str());
     return kExitOk;
@@ -271,7 +264,10 @@ int run(int argc, char** argv) {
   const auto t_fields = std::chrono::steady_clock::now();
   PipelineOptions pipeline;
   pipeline.smooth_sigma_voxels = o.smooth;
+  ProgressBar fields_bar("n and grad n", !o.quiet);
+  pipeline.progress = fields_bar.callback();
   Volume volume = buildVolume(regions, grid, pipeline);
+  fields_bar.finish();
   regions.clear();
   stats["time_fields_s"] = seconds_since(t_fields);
   json sources = json::array();

@@ -5,10 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 #include <string>
 
 #include "core/error.h"
+#include "core/testing.h"
 #include "voxelize/mesh_scene.h"
 
 namespace eik {
@@ -16,17 +16,9 @@ namespace {
 
 class ObjLoader : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("eikonal_obj_test_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    std::filesystem::remove_all(dir_);
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-
   std::filesystem::path write(const std::string& name, const std::string& text) {
     const auto path = dir_ / name;
-    std::ofstream(path, std::ios::binary) << text;
+    test_support::writeFile(path, text);
     return path;
   }
   void expectInputError(const std::string& text, std::initializer_list<const char*> parts) {
@@ -41,7 +33,7 @@ class ObjLoader : public ::testing::Test {
     }
   }
 
-  std::filesystem::path dir_;
+  test_support::TempDir dir_{"eikonal-obj"};
 };
 
 // A unit cube: 8 vertices, 6 quads.
