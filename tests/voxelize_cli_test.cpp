@@ -167,6 +167,9 @@ struct BadCase {
   const char* expected;       // must appear in the message
 };
 
+// gtest prints a parameter in test names and failures: show its name, not its bytes.
+void PrintTo(const BadCase& c, std::ostream* os) { *os << c.name; }
+
 class VoxelizeBadInput : public ::testing::TestWithParam<BadCase> {};
 
 TEST_P(VoxelizeBadInput, ExitsTwoNamingTheProblemAndWritesNothing) {
