@@ -1,0 +1,89 @@
+// The wavefront light simulator (thesis §4.2, §6.2; lightsim/ALGORITHM.md is the specification):
+// one interface, two back ends that are siblings — the GPU particle system (OpenGL 3.3 fragment
+// shaders, gpu_simulator.h) and its CPU twin (cpu_simulator.h), which the tests use to check the
+// GPU path and which serves as a fallback.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include "core/progress.h"
+#include "core/volume.h"
+
+namespace eik {
+
+struct LightSpec {
+  enum class Type { Directional, Point };
+  Type type = Type::Directional;
+  glm::dvec3 direction{0.0, -1.0, 0.0};  // directional: unit direction the light travels
+  glm::dvec3 position{0.0};              // point
+  // Directional: irradiance on a plane facing the light (W/m², RGB). Point: radiant intensity
+  // (W/sr, RGB). DESIGN §4.2 --power.
+  glm::dvec3 power{1.0};
+  nlohmann::json toJson() const;         // as a SCENE.json light
+};
+
+enum class DepositMode { Accumulate, Max };
+enum class Integrator { Euler, RK2, RK4 };
+
+struct SimulationOptions {
+  DepositMode deposit = DepositMode::Accumulate;
+  Integrator integrator = Integrator::Euler;
+  double step_voxels = 0.5;       // Δt = step_voxels·h: the arc length per step in air, in voxels
+  double patch_voxels = 1.0;      // initial patch edge, at most this many voxels
+  double split_voxels = 1.0;      // split a patch whose longest edge exceeds this many voxels
+  int max_depth = 8;              // splits allowed per initial patch
+  double flux_threshold = 1e-4;   // kill below this fraction of the largest initial patch flux / 4^depth
+  int max_steps = 0;              // 0: 4 × the grid diagonal in steps
+  double boundary_on = 0.02;      // |∇n|·h entering a boundary layer (Fresnel tracking)
+  double boundary_off = 0.01;     // |∇n|·h leaving it
+  ProgressFn progress;            // fraction of the entering flux retired (dead or exited)
+};
+
+struct KillCounts {
+  std::uint64_t flux = 0;     // energy under the threshold
+  std::uint64_t exited = 0;   // left the volume, heading away
+  std::uint64_t folded = 0;   // orientation flipped (caustic singularity)
+  std::uint64_t depth = 0;    // needed a split beyond max_depth
+};
+
+struct SimulationStats {
+  int steps = 0;
+  std::uint64_t initial_patches = 0;
+  std::uint64_t peak_patches = 0;
+  std::uint64_t total_patches = 0;   // Σ over steps of live patches (patch-steps)
+  std::uint64_t splits = 0;
+  KillCounts kills;
+  // Fluxes in W, RGB. flux_in = out + absorbed + reflected + killed + unfinished.
+  glm::dvec3 flux_in{0.0};
+  glm::dvec3 flux_out{0.0};          // carried out of the volume by exiting patches
+  glm::dvec3 flux_absorbed{0.0};
+  glm::dvec3 flux_reflected{0.0};    // Fresnel reflection at boundaries
+  glm::dvec3 flux_killed{0.0};       // flux, folded and depth kills
+  glm::dvec3 flux_unfinished{0.0};   // still alive at max_steps
+  std::map<std::string, double> phase_seconds;   // "init", "update", "analysis", "compact", "deposit", "readback", ...
+  std::string backend;               // "gl" or "cpu"
+  std::string renderer;              // GL renderer string or "cpu, N threads"
+  nlohmann::json toJson() const;
+};
+
+// What a bake adds to a volume (DESIGN §4.1).
+struct BakeResult {
+  Field irradiance;   // 3 components, W/m²
+  Field light_dir;    // 3 components, unit (0 where no light passed)
+  SimulationStats stats;
+};
+
+class Simulator {
+ public:
+  virtual ~Simulator() = default;
+  // Propagates the light's wavefront through the volume given at construction.
+  virtual BakeResult run(const LightSpec& light, const SimulationOptions& options) = 0;
+};
+
+}  // namespace eik
