@@ -1,0 +1,121 @@
+#include "lightsim/bake.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <stdexcept>
+#include <vector>
+
+#include "core/error.h"
+
+namespace eik {
+
+namespace {
+
+nlohmann::json vec3Json(const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
+
+// Comma-separated finite numbers; InputError naming `source` otherwise.
+std::vector<double> parseNumbers(const std::string& text, const std::string& source, const std::string& what) {
+  std::vector<double> values;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t comma = text.find(',', start);
+    const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    const char* begin = item.c_str();
+    char* end = nullptr;
+    errno = 0;
+    const double v = std::strtod(begin, &end);
+    while (end && (*end == ' ' || *end == '\t')) ++end;
+    if (item.empty() || end == begin || *end != '\0' || errno == ERANGE || !std::isfinite(v))
+      throw InputError(source, what, "'" + item + "' is not a finite number (in '" + text + "')");
+    values.push_back(v);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return values;
+}
+
+}  // namespace
+
+nlohmann::json LightSpec::toJson() const {
+  if (type == Type::Directional)
+    return {{"type", "directional"}, {"direction", vec3Json(direction)}, {"irradiance", vec3Json(power)}};
+  return {{"type", "point"}, {"position", vec3Json(position)}, {"intensity", vec3Json(power)}};
+}
+
+nlohmann::json SimulationStats::toJson() const {
+  nlohmann::json j;
+  j["steps"] = steps;
+  j["initial_patches"] = initial_patches;
+  j["peak_patches"] = peak_patches;
+  j["total_patches"] = total_patches;
+  j["splits"] = splits;
+  j["kills"] = {{"flux", kills.flux}, {"exited", kills.exited}, {"folded", kills.folded}, {"depth", kills.depth}};
+  // The energy ledger: flux_in = out + absorbed + reflected + killed + unfinished (W, RGB).
+  const glm::dvec3 accounted = flux_out + flux_absorbed + flux_reflected + flux_killed + flux_unfinished;
+  const double scale = std::max(std::fabs(flux_in.x), std::max(std::fabs(flux_in.y), std::fabs(flux_in.z)));
+  const glm::dvec3 residual = flux_in - accounted;
+  const double worst = std::max(std::fabs(residual.x), std::max(std::fabs(residual.y), std::fabs(residual.z)));
+  j["flux"] = {{"in", vec3Json(flux_in)},
+               {"out", vec3Json(flux_out)},
+               {"absorbed", vec3Json(flux_absorbed)},
+               {"reflected", vec3Json(flux_reflected)},
+               {"killed", vec3Json(flux_killed)},
+               {"unfinished", vec3Json(flux_unfinished)},
+               {"ledger_relative_residual", scale > 0.0 ? worst / scale : 0.0}};
+  j["phase_seconds"] = nlohmann::json::object();
+  for (const auto& [name, seconds] : phase_seconds) j["phase_seconds"][name] = seconds;
+  j["backend"] = backend;
+  j["renderer"] = renderer;
+  nlohmann::json warnings = nlohmann::json::array();
+  if (initial_patches == 0) warnings.push_back("the light misses the volume: the bake is empty");
+  if (flux_unfinished.x + flux_unfinished.y + flux_unfinished.z > 0.0)
+    warnings.push_back("max_steps reached with patches still alive (flux_unfinished)");
+  j["warnings"] = warnings;
+  return j;
+}
+
+void applyBake(Volume& volume, const BakeResult& result, const LightSpec& light) {
+  const std::size_t n = volume.grid.count();
+  auto check = [n](const Field& f, const char* name) {
+    if (f.components != 3 || f.data.size() != n * 3)
+      throw std::invalid_argument(std::string("applyBake: ") + name + " does not match the volume's grid");
+  };
+  check(result.irradiance, "irradiance");
+  check(result.light_dir, "light_dir");
+  volume.fields["irradiance"] = result.irradiance;
+  volume.fields["light_dir"] = result.light_dir;
+  volume.metadata["light"] = light.toJson();
+  volume.metadata["bake_stats"] = result.stats.toJson();
+}
+
+LightSpec parseLight(const std::string& light_text, const std::string& power_text) {
+  LightSpec light;
+  const std::size_t colon = light_text.find(':');
+  const std::string kind = light_text.substr(0, colon);
+  if (colon == std::string::npos || (kind != "directional" && kind != "point"))
+    throw InputError("--light", "", "'" + light_text + "': expected directional:DX,DY,DZ or point:X,Y,Z");
+  const std::vector<double> v = parseNumbers(light_text.substr(colon + 1), "--light", kind);
+  if (v.size() != 3) throw InputError("--light", kind, "'" + light_text + "': expected three numbers");
+  const glm::dvec3 xyz(v[0], v[1], v[2]);
+  if (kind == "directional") {
+    const double len = glm::length(xyz);
+    if (!(len > 0.0) || !std::isfinite(len))
+      throw InputError("--light", "directional", "'" + light_text + "': the direction must not be zero");
+    light.type = LightSpec::Type::Directional;
+    light.direction = xyz / len;
+  } else {
+    light.type = LightSpec::Type::Point;
+    light.position = xyz;
+  }
+  const std::vector<double> p = parseNumbers(power_text, "--power", "");
+  if (p.size() != 1 && p.size() != 3) throw InputError("--power", "", "'" + power_text + "': expected R,G,B or one value");
+  light.power = p.size() == 1 ? glm::dvec3(p[0]) : glm::dvec3(p[0], p[1], p[2]);
+  if (light.power.x < 0.0 || light.power.y < 0.0 || light.power.z < 0.0)
+    throw InputError("--power", "", "'" + power_text + "': must not be negative");
+  if (light.power.x == 0.0 && light.power.y == 0.0 && light.power.z == 0.0)
+    throw InputError("--power", "", "'" + power_text + "': must not be zero in every channel");
+  return light;
+}
+
+}  // namespace eik

@@ -1,0 +1,27 @@
+// What a bake adds to a volume (ALGORITHM.md "Bake output", DESIGN §4.1), and reading the light
+// of `lightsim --light ... --power ...` (DESIGN §4.2).
+#pragma once
+
+#include <string>
+
+#include "core/volume.h"
+#include "lightsim/simulator.h"
+
+namespace eik {
+
+// Adds (or replaces) the fields `irradiance` (RGB, W/m²) and `light_dir` (unit, 0 where no light
+// passed) and the manifest entries "light" (LightSpec::toJson) and "bake_stats"
+// (SimulationStats::toJson). Throws std::invalid_argument when the result's fields do not fit the
+// volume's grid (3 components, one per voxel).
+void applyBake(Volume& volume, const BakeResult& result, const LightSpec& light);
+
+// Parses `--light` ("directional:DX,DY,DZ" or "point:X,Y,Z") and `--power` ("R,G,B", or one value
+// for all three channels). The direction is normalised. Throws InputError naming --light or
+// --power for malformed text, a non-finite number, a zero direction, a negative channel or a power
+// that is zero in every channel.
+LightSpec parseLight(const std::string& light, const std::string& power = "1,1,1");
+
+// True when the bake had no initial patch: the light misses the volume (the bake is all zeros).
+inline bool lightMissedVolume(const SimulationStats& stats) { return stats.initial_patches == 0; }
+
+}  // namespace eik

@@ -1,0 +1,318 @@
+#include "lightsim/cpu_simulator.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "core/parallel.h"
+
+namespace eik {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+// The right-hand side of the wavefront ray equation in time t (Eq. 4.12/4.13):
+// dx/dt = w/n², dw/dt = ∇n/n, with n and ∇n sampled at x.
+struct Derivative {
+  glm::dvec3 dx, dw;
+};
+inline Derivative rayRhs(const glm::dvec3& x, const glm::dvec3& w, const VolumeSampler& sampler) {
+  const glm::dvec4 s = sampler.iorAndGradient(x);
+  const double n = s.x;
+  return {w / (n * n), glm::dvec3(s.y, s.z, s.w) / n};
+}
+
+// Voxel containing p, or −1 outside the grid.
+inline long long containingVoxel(const GridSpec& grid, const glm::dvec3& p) {
+  const glm::dvec3 c = glm::floor(grid.toVoxel(p));
+  if (!(c.x >= 0.0 && c.y >= 0.0 && c.z >= 0.0 && c.x < grid.dims.x && c.y < grid.dims.y && c.z < grid.dims.z))
+    return -1;
+  return static_cast<long long>(grid.index(static_cast<int>(c.x), static_cast<int>(c.y), static_cast<int>(c.z)));
+}
+
+inline double maxChannel(const glm::dvec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
+
+}  // namespace
+
+void advanceCorner(glm::dvec3& x, glm::dvec3& w, double dt, Integrator integrator, const VolumeSampler& sampler) {
+  switch (integrator) {
+    case Integrator::Euler: {
+      // Eq. 6.1: x ← x + Δt·w/n²; Eq. 6.2: w ← w + Δt·∇n/n (both with n, ∇n at the old x).
+      const Derivative k = rayRhs(x, w, sampler);
+      x += dt * k.dx;
+      w += dt * k.dw;
+      break;
+    }
+    case Integrator::RK2: {  // midpoint
+      const Derivative k1 = rayRhs(x, w, sampler);
+      const Derivative k2 = rayRhs(x + (0.5 * dt) * k1.dx, w + (0.5 * dt) * k1.dw, sampler);
+      x += dt * k2.dx;
+      w += dt * k2.dw;
+      break;
+    }
+    case Integrator::RK4: {  // classical
+      const Derivative k1 = rayRhs(x, w, sampler);
+      const Derivative k2 = rayRhs(x + (0.5 * dt) * k1.dx, w + (0.5 * dt) * k1.dw, sampler);
+      const Derivative k3 = rayRhs(x + (0.5 * dt) * k2.dx, w + (0.5 * dt) * k2.dw, sampler);
+      const Derivative k4 = rayRhs(x + dt * k3.dx, w + dt * k3.dw, sampler);
+      x += (dt / 6.0) * (k1.dx + 2.0 * k2.dx + 2.0 * k3.dx + k4.dx);
+      w += (dt / 6.0) * (k1.dw + 2.0 * k2.dw + 2.0 * k3.dw + k4.dw);
+      break;
+    }
+  }
+  // |w| = n along an exact ray: renormalise to n at the new position (ALGORITHM.md step 1).
+  w = renormalised(w, sampler.ior(x));
+}
+
+PatchStepResult stepPatch(Patch& patch, const StepContext& ctx) {
+  const VolumeSampler& sampler = *ctx.sampler;
+  const SimulationOptions& options = *ctx.options;
+  const GridSpec& grid = sampler.grid();
+  const double h = sampler.h();
+  PatchStepResult result;
+
+  const glm::dvec3 m_old = patch.midpoint();
+  result.old_midpoint = m_old;
+  const glm::dvec3 d_old = patch.direction();
+  const double n_m_old = sampler.ior(m_old);
+  const double ds = ctx.dt / n_m_old;  // Δs_m = Δt/n(m) (Eq. 4.11)
+
+  // 1. Update (§6.2.2, Eq. 6.1/6.2 or RK2/RK4), then |w| = n(x_new).
+  for (int c = 0; c < 4; ++c) advanceCorner(patch.x[c], patch.w[c], ctx.dt, options.integrator, sampler);
+
+  // 2. Absorption at the old midpoint: Φ ← Φ·exp(−σa(m)·Δs_m) (Beer–Lambert).
+  if (sampler.hasAbsorption()) {
+    const glm::dvec3 sigma = sampler.sigmaA(m_old);
+    const glm::dvec3 transmitted = glm::exp(-sigma * ds);
+    result.absorbed = patch.flux * (1.0 - transmitted);
+    patch.flux *= transmitted;
+  }
+
+  // 3. Fresnel at boundary layers (DESIGN §5; seeds/README.md formulas).
+  const glm::dvec3 m_new = patch.midpoint();
+  const glm::dvec3 d_new = patch.direction();
+  const glm::dvec4 ng = sampler.iorAndGradient(m_new);
+  const glm::dvec3 grad(ng.y, ng.z, ng.w);
+  const double grad_len = glm::length(grad);
+  const double g = grad_len * h;  // index change per voxel
+  patch.t_fresnel = 1.0;
+  if (patch.n_in == 0.0 && g > options.boundary_on) {
+    patch.n_in = n_m_old;
+    patch.cos_in = std::fabs(glm::dot(d_old, grad / grad_len));
+  } else if (patch.n_in != 0.0 && g < options.boundary_off) {
+    const double cos_out = grad_len > 0.0 ? std::fabs(glm::dot(d_new, grad / grad_len)) : -1.0;
+    const double reflectance = boundaryReflectance(patch.n_in, patch.cos_in, ng.x, cos_out, options.boundary_off);
+    result.reflected = patch.flux * reflectance;
+    patch.flux *= 1.0 - reflectance;
+    patch.t_fresnel = 1.0 - reflectance;
+    patch.n_in = 0.0;
+  }
+
+  // 4. Deposit record (§6.2.3): the voxel of the new midpoint, only inside the grid.
+  const glm::dvec3 N = patch.areaVector();
+  result.voxel = containingVoxel(grid, m_new);
+  if (result.voxel >= 0) {
+    if (options.deposit == DepositMode::Accumulate) {
+      result.deposit = patch.flux * (ds / ctx.voxel_volume);
+      result.deposit_dir = (luminance(patch.flux) * ds) * d_new;
+    } else {
+      const double area = glm::length(N);
+      result.deposit = area > 0.0 ? patch.flux / area : glm::dvec3(0.0);
+      result.deposit_dir = d_new;
+      result.max_key = luminance(result.deposit);
+    }
+  }
+
+  // 5. Analysis (§6.2.4).
+  if (maxChannel(patch.flux) < fluxKillThreshold(ctx.flux_ref, options, patch.depth)) {
+    result.fate = PatchFate::KilledFlux;
+  } else if (!insideBox(m_new, grid.bounds_min, grid.bounds_max) &&
+             !rayHitsBox(m_new, d_new, grid.bounds_min, grid.bounds_max)) {
+    result.fate = PatchFate::Exited;
+  } else if (options.deposit == DepositMode::Max && !(glm::dot(N, d_new) > 0.0)) {
+    result.fate = PatchFate::Folded;  // orientation flipped: a caustic singularity
+  } else if (patch.longestEdge() > options.split_voxels * h) {
+    result.fate = patch.depth >= options.max_depth ? PatchFate::KilledDepth : PatchFate::Split;
+  } else {
+    result.fate = PatchFate::Keep;
+  }
+  return result;
+}
+
+CpuSimulator::CpuSimulator(const Volume& volume) : sampler_(volume) {}
+
+BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& options) { return run(light, options, {}); }
+
+BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& options, std::span<PlaneFluxProbe> probes) {
+  for (PlaneFluxProbe& probe : probes) {
+    if (probe.axis < 0 || probe.axis > 2) throw std::invalid_argument("PlaneFluxProbe: axis must be 0, 1 or 2");
+    probe.to_positive = probe.to_negative = glm::dvec3(0.0);
+  }
+  const GridSpec& grid = sampler_.grid();
+  const std::size_t voxels = grid.count();
+  BakeResult bake;
+  SimulationStats& stats = bake.stats;
+  stats.backend = "cpu";
+  const unsigned threads = workerThreads();
+  stats.renderer = "cpu, " + std::to_string(threads) + (threads == 1 ? " thread" : " threads");
+
+  auto t0 = Clock::now();
+  double flux_ref = 0.0;
+  std::vector<Patch> patches = initialPatches(light, grid, sampler_, options, &flux_ref);
+  stats.initial_patches = patches.size();
+  for (const Patch& p : patches) stats.flux_in += p.flux;
+  stats.phase_seconds["init"] = secondsSince(t0);
+
+  StepContext ctx;
+  ctx.sampler = &sampler_;
+  ctx.options = &options;
+  ctx.dt = timeStep(grid, options);
+  ctx.flux_ref = flux_ref;
+  ctx.voxel_volume = grid.voxelVolume();
+  const int max_steps = maxSteps(grid, options);
+  const bool accumulate = options.deposit == DepositMode::Accumulate;
+
+  // Deposit targets, in double (accumulate) or the strongest patch so far (max).
+  std::vector<glm::dvec3> irradiance(patches.empty() ? 0 : voxels, glm::dvec3(0.0));
+  std::vector<glm::dvec3> direction(patches.empty() ? 0 : voxels, glm::dvec3(0.0));
+  std::vector<double> best_key(accumulate || patches.empty() ? 0 : voxels, -1.0);
+
+  std::vector<PatchStepResult> results;
+  std::vector<std::uint64_t> offsets;
+  std::vector<Patch> next;
+  double t_update = 0.0, t_deposit = 0.0, t_compact = 0.0;
+  const double total_in = luminance(stats.flux_in);
+
+  for (int step = 0; step < max_steps && !patches.empty(); ++step) {
+    const std::size_t count = patches.size();
+    stats.steps = step + 1;
+    stats.peak_patches = std::max<std::uint64_t>(stats.peak_patches, count);
+    stats.total_patches += count;
+
+    // Steps 1–5 per patch, in parallel (each patch independent: deterministic).
+    auto t = Clock::now();
+    results.resize(count);
+    parallelFor(
+        0, static_cast<std::int64_t>(count),
+        [&](std::int64_t i) { results[static_cast<std::size_t>(i)] = stepPatch(patches[static_cast<std::size_t>(i)], ctx); },
+        256);
+    t_update += secondsSince(t);
+
+    // Deposit and the ledger, sequentially in patch order (deterministic sums).
+    t = Clock::now();
+    offsets.resize(count + 1);
+    std::uint64_t total = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+      const PatchStepResult& r = results[i];
+      const Patch& p = patches[i];
+      stats.flux_absorbed += r.absorbed;
+      stats.flux_reflected += r.reflected;
+      for (PlaneFluxProbe& probe : probes) {
+        const bool before = r.old_midpoint[probe.axis] > probe.coordinate;
+        const bool after = p.midpoint()[probe.axis] > probe.coordinate;
+        if (before && !after) probe.to_negative += p.flux;
+        if (!before && after) probe.to_positive += p.flux;
+      }
+      if (r.voxel >= 0) {
+        const std::size_t v = static_cast<std::size_t>(r.voxel);
+        if (accumulate) {
+          irradiance[v] += r.deposit;
+          direction[v] += r.deposit_dir;
+        } else if (r.max_key > best_key[v]) {
+          best_key[v] = r.max_key;
+          irradiance[v] = r.deposit;
+          direction[v] = r.deposit_dir;
+        }
+      }
+      offsets[i] = total;
+      switch (r.fate) {
+        case PatchFate::Keep: total += 1; break;
+        case PatchFate::Split:
+          total += 4;
+          ++stats.splits;
+          break;
+        case PatchFate::KilledFlux:
+          ++stats.kills.flux;
+          stats.flux_killed += p.flux;
+          break;
+        case PatchFate::Exited:
+          ++stats.kills.exited;
+          stats.flux_out += p.flux;
+          break;
+        case PatchFate::Folded:
+          ++stats.kills.folded;
+          stats.flux_killed += p.flux;
+          break;
+        case PatchFate::KilledDepth:
+          ++stats.kills.depth;
+          stats.flux_killed += p.flux;
+          break;
+      }
+    }
+    offsets[count] = total;
+    t_deposit += secondsSince(t);
+
+    // Step 6: compaction and expansion by the prefix sum, in index order (the histogram pyramid's
+    // order: output slot k of source s with sub-index j = child j of the split).
+    t = Clock::now();
+    next.resize(total);
+    parallelFor(
+        0, static_cast<std::int64_t>(count),
+        [&](std::int64_t i64) {
+          const std::size_t i = static_cast<std::size_t>(i64);
+          const std::size_t out = offsets[i];
+          const std::size_t n_out = offsets[i + 1] - out;
+          if (n_out == 1) {
+            next[out] = patches[i];
+          } else if (n_out == 4) {
+            const std::array<Patch, 4> children = splitPatch(patches[i], sampler_);
+            for (int j = 0; j < 4; ++j) next[out + j] = children[j];
+          }
+        },
+        256);
+    patches.swap(next);
+    t_compact += secondsSince(t);
+
+    if (options.progress && total_in > 0.0) {
+      const double retired =
+          luminance(stats.flux_out + stats.flux_absorbed + stats.flux_reflected + stats.flux_killed) / total_in;
+      options.progress(std::min(1.0, retired));
+    }
+  }
+  for (const Patch& p : patches) stats.flux_unfinished += p.flux;
+
+  // Output fields.
+  t0 = Clock::now();
+  bake.irradiance.components = 3;
+  bake.irradiance.data.assign(voxels * 3, 0.0f);
+  bake.light_dir.components = 3;
+  bake.light_dir.data.assign(voxels * 3, 0.0f);
+  if (!irradiance.empty()) {
+    parallelFor(
+        0, static_cast<std::int64_t>(voxels),
+        [&](std::int64_t v64) {
+          const std::size_t v = static_cast<std::size_t>(v64);
+          float* e = bake.irradiance.voxel(v);
+          float* d = bake.light_dir.voxel(v);
+          for (int c = 0; c < 3; ++c) e[c] = static_cast<float>(irradiance[v][c]);
+          const double len = glm::length(direction[v]);
+          if (len > 0.0)
+            for (int c = 0; c < 3; ++c) d[c] = static_cast<float>(direction[v][c] / len);
+        },
+        4096);
+  }
+  stats.phase_seconds["update"] = t_update;
+  stats.phase_seconds["deposit"] = t_deposit;
+  stats.phase_seconds["compact"] = t_compact;
+  stats.phase_seconds["output"] = secondsSince(t0);
+  if (options.progress) options.progress(1.0);
+  return bake;
+}
+
+}  // namespace eik

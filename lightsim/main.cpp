@@ -1,0 +1,145 @@
+// lightsim: bakes a light's wavefront into a volume (thesis §4, §6.2; DESIGN §4.2; ALGORITHM.md).
+//
+//   lightsim IN.vol.json -o OUT.vol.json --light directional:DX,DY,DZ | point:X,Y,Z
+//            [--power R,G,B] [--backend gl|cpu] [--deposit accumulate|max] [--stats FILE.json]
+//
+// The work lives in the library (gpu_simulator.h, cpu_simulator.h, bake.h); this file reads the
+// command line, reports progress and writes the outputs.
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "core/atomic_file.h"
+#include "core/cli.h"
+#include "core/error.h"
+#include "core/progress.h"
+#include "core/scene.h"
+#include "core/volume.h"
+#include "lightsim/bake.h"
+#include "lightsim/cpu_simulator.h"
+#include "lightsim/gpu_simulator.h"
+
+namespace fs = std::filesystem;
+
+namespace eik {
+namespace {
+
+// The first light of a SCENE.json, as a LightSpec.
+LightSpec lightFromScene(const fs::path& file) {
+  Scene scene = readScene(file);
+  if (scene.lights.empty()) throw InputError(file.string(), "lights", "the scene has no light to bake");
+  const SceneLightSpec& l = scene.lights.front();
+  LightSpec light;
+  if (l.type == SceneLightSpec::Type::Directional) {
+    light.type = LightSpec::Type::Directional;
+    light.direction = l.direction;
+    light.power = l.irradiance;
+  } else {
+    light.type = LightSpec::Type::Point;
+    light.position = l.position;
+    light.power = l.intensity;
+  }
+  if (!(light.power.x > 0 || light.power.y > 0 || light.power.z > 0))
+    throw InputError(file.string(), "lights[0]", "the light has no power");
+  return light;
+}
+
+int run(int argc, char** argv) {
+  std::string input, output, light_text, power_text = "1,1,1", scene_path, backend = "gl", deposit = "accumulate",
+                                         integrator = "euler", stats_path, gl_backend = "auto";
+  SimulationOptions options;
+  bool quiet = false, raw = false;
+  CLI::App app{
+      "lightsim: propagate a light's wavefront through a volume as a GPU particle system of adaptive\n"
+      "patches and bake irradiance and light direction into it (thesis §4, §6.2).",
+      "lightsim"};
+  app.add_option("input", input, "the volume to bake, IN.vol.json (needs ior and ior_grad; sigma_a if absorbing)")
+      ->required();
+  app.add_option("-o,--output", output, "the baked volume, OUT.vol.json (IN plus irradiance and light_dir)")->required();
+  app.add_option("--light", light_text, "directional:DX,DY,DZ (direction of travel) or point:X,Y,Z");
+  app.add_option("--power", power_text,
+                 "R,G,B: irradiance in W/m² of a directional light, radiant intensity in W/sr of a point light "
+                 "(default 1,1,1)");
+  app.add_option("--scene", scene_path, "take the light from this SCENE.json (its first light) instead of --light");
+  app.add_option("--backend", backend, "gl (the GPU particle system, default) or cpu (the CPU twin)")
+      ->check(CLI::IsMember({"gl", "cpu"}));
+  app.add_option("--deposit", deposit,
+                 "accumulate (default: sums every wavefront sheet, conserves energy) or max (the thesis: the "
+                 "strongest patch per voxel)")
+      ->check(CLI::IsMember({"accumulate", "max"}));
+  app.add_option("--integrator", integrator, "euler (Eq. 6.1/6.2, default), rk2 or rk4")
+      ->check(CLI::IsMember({"euler", "rk2", "rk4"}));
+  app.add_option("--step", options.step_voxels, "time step: arc length per step in air, in voxels (default 0.5)")
+      ->check(CLI::Range(0.01, 4.0));
+  app.add_option("--patch", options.patch_voxels, "initial patch edge in voxels (default 1)")->check(CLI::Range(0.05, 8.0));
+  app.add_option("--split", options.split_voxels, "split patches with an edge longer than this, in voxels (default 1)")
+      ->check(CLI::Range(0.1, 16.0));
+  app.add_option("--max-depth", options.max_depth, "splits allowed per initial patch (default 8)")->check(CLI::Range(0, 16));
+  app.add_option("--max-steps", options.max_steps, "step limit (default: 4 grid diagonals)")->check(CLI::Range(0, 1000000));
+  app.add_option("--flux-threshold", options.flux_threshold,
+                 "kill patches below this fraction of the initial patch flux (default 1e-4)")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--gl", gl_backend, "OpenGL back end for --backend gl: auto | osmesa | egl (default auto)");
+  app.add_option("--stats", stats_path, "write steps, patches, splits, kills, flux ledger and phase times as JSON");
+  app.add_flag("--raw", raw, "write raw NRRD data instead of gzip");
+  app.add_flag("-q,--quiet", quiet, "no progress bar");
+  app.footer(
+      "Examples:\n"
+      "  lightsim sphere.vol.json -o sphere.baked.vol.json --light directional:0,-1,0 --power 1,1,1\n"
+      "  lightsim glass.vol.json -o glass.baked.vol.json --scene glass.scene.json --backend cpu\n"
+      "Exit codes: 0 success, 1 runtime failure, 2 bad usage or bad input.");
+  if (!parseCommandLine(app, argc, argv)) return kExitOk;
+
+  if (output.size() < 9 || output.substr(output.size() - 9) != ".vol.json")
+    throw InputError("-o", output, "the output manifest must end in .vol.json");
+  for (const std::string* path : {&output, &stats_path}) {
+    if (path->empty()) continue;
+    fs::path dir = fs::absolute(*path).parent_path();
+    if (!fs::is_directory(dir)) throw InputError(*path, "", "directory " + dir.string() + " does not exist");
+  }
+  if (light_text.empty() == scene_path.empty())
+    throw InputError("command line", "--light", "give either --light (with --power) or --scene");
+  const LightSpec light = scene_path.empty() ? parseLight(light_text, power_text) : lightFromScene(scene_path);
+  options.deposit = deposit == "max" ? DepositMode::Max : DepositMode::Accumulate;
+  options.integrator = integrator == "rk4" ? Integrator::RK4 : integrator == "rk2" ? Integrator::RK2 : Integrator::Euler;
+
+  Volume volume = readVolume(input);
+  volume.require("ior", 1, input);
+  volume.require("ior_grad", 3, input);
+
+  std::unique_ptr<Simulator> simulator;
+  if (backend == "cpu") {
+    simulator = std::make_unique<CpuSimulator>(volume);
+  } else {
+    GpuSimulatorOptions gpu;
+    gpu.source = input;
+    gpu.backend = gl::parseGlBackend(gl_backend);
+    simulator = std::make_unique<GpuSimulator>(volume, gpu);
+  }
+  ProgressBar bar("lightsim", !quiet);
+  options.progress = bar.callback();
+  BakeResult result = simulator->run(light, options);
+  bar.finish();
+  if (lightMissedVolume(result.stats))
+    std::fprintf(stderr, "lightsim: warning: the light misses the volume; the bake is empty\n");
+
+  applyBake(volume, result, light);
+  VolumeWriteOptions write;
+  write.gzip = !raw;
+  writeVolume(volume, output, write);
+  if (!stats_path.empty()) writeFileAtomic(stats_path, result.stats.toJson().dump(2) + "\n");
+  if (!quiet) {
+    const SimulationStats& s = result.stats;
+    std::fprintf(stderr, "lightsim: %d steps, %llu initial / %llu peak patches, %llu splits on %s\n", s.steps,
+                 static_cast<unsigned long long>(s.initial_patches), static_cast<unsigned long long>(s.peak_patches),
+                 static_cast<unsigned long long>(s.splits), s.renderer.c_str());
+    std::fprintf(stderr, "lightsim: wrote %s\n", output.c_str());
+  }
+  return kExitOk;
+}
+
+}  // namespace
+}  // namespace eik
+
+int main(int argc, char** argv) { return eik::runMain("lightsim", eik::run, argc, argv); }

@@ -1,0 +1,146 @@
+// The GPU patch list: Morton placement, allocation, upload and readback (see patch_textures.h).
+#include "lightsim/patch_textures.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <stdexcept>
+
+#include "core/error.h"
+#include "gl/context.h"
+
+namespace eik {
+
+namespace {
+
+std::uint32_t part1By1(std::uint32_t v) {
+  v &= 0x0000ffffu;
+  v = (v ^ (v << 8)) & 0x00ff00ffu;
+  v = (v ^ (v << 4)) & 0x0f0f0f0fu;
+  v = (v ^ (v << 2)) & 0x33333333u;
+  v = (v ^ (v << 1)) & 0x55555555u;
+  return v;
+}
+
+std::uint32_t compact1By1(std::uint32_t v) {
+  v &= 0x55555555u;
+  v = (v ^ (v >> 1)) & 0x33333333u;
+  v = (v ^ (v >> 2)) & 0x0f0f0f0fu;
+  v = (v ^ (v >> 4)) & 0x00ff00ffu;
+  v = (v ^ (v >> 8)) & 0x0000ffffu;
+  return v;
+}
+
+}  // namespace
+
+glm::ivec2 mortonTexel(std::uint32_t index) {
+  return {static_cast<int>(compact1By1(index)), static_cast<int>(compact1By1(index >> 1))};
+}
+
+std::uint32_t mortonIndex(glm::ivec2 texel) {
+  return part1By1(static_cast<std::uint32_t>(texel.x)) | (part1By1(static_cast<std::uint32_t>(texel.y)) << 1);
+}
+
+glm::ivec2 mortonBox(std::size_t count) {
+  if (count == 0) return {0, 0};
+  const int bits = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(count - 1)));
+  return {1 << ((bits + 1) / 2), 1 << (bits / 2)};
+}
+
+int patchSideFor(std::size_t count, int minimum) {
+  int side = std::max(1, minimum);
+  while (static_cast<std::size_t>(side) * static_cast<std::size_t>(side) < count) side *= 2;
+  return side;
+}
+
+PatchTexels packPatch(const Patch& p) {
+  PatchTexels t;
+  for (std::size_t c = 0; c < 4; ++c) t[c] = glm::vec4(glm::vec3(p.x[c]), static_cast<float>(p.w[c].x));
+  t[4] = glm::vec4(p.w[0].y, p.w[0].z, p.w[1].y, p.w[1].z);
+  t[5] = glm::vec4(p.w[2].y, p.w[2].z, p.w[3].y, p.w[3].z);
+  t[6] = glm::vec4(glm::vec3(p.flux), static_cast<float>(p.area0));
+  t[7] = glm::vec4(static_cast<float>(p.depth), static_cast<float>(p.n_in), static_cast<float>(p.cos_in),
+                   static_cast<float>(p.t_fresnel));
+  return t;
+}
+
+Patch unpackPatch(const PatchTexels& t) {
+  Patch p;
+  for (std::size_t c = 0; c < 4; ++c) p.x[c] = glm::dvec3(t[c]);
+  p.w[0] = glm::dvec3(t[0].w, t[4].x, t[4].y);
+  p.w[1] = glm::dvec3(t[1].w, t[4].z, t[4].w);
+  p.w[2] = glm::dvec3(t[2].w, t[5].x, t[5].y);
+  p.w[3] = glm::dvec3(t[3].w, t[5].z, t[5].w);
+  p.flux = glm::dvec3(t[6]);
+  p.area0 = t[6].w;
+  p.depth = static_cast<int>(std::lround(t[7].x));
+  p.n_in = t[7].y;
+  p.cos_in = t[7].z;
+  p.t_fresnel = t[7].w;
+  return p;
+}
+
+std::string PatchTextures::samplerName(const std::string& prefix, int slot) {
+  return prefix + "[" + std::to_string(slot) + "]";
+}
+
+PatchTextures::PatchTextures(int side) : side_(side) {
+  if (side < 1 || (side & (side - 1)) != 0) {
+    throw std::invalid_argument("PatchTextures: side " + std::to_string(side) + " is not a power of two");
+  }
+  const gl::Sampling nearest{gl::Filter::Nearest, gl::Wrap::ClampToEdge};
+  framebuffer_ = gl::Framebuffer({side, side});
+  for (int slot = 0; slot < kAttachments; ++slot) {
+    textures_[static_cast<std::size_t>(slot)] = gl::Texture2D({side, side}, gl::TextureFormat::RGBA32F, nearest);
+    framebuffer_.attach(slot, textures_[static_cast<std::size_t>(slot)]);
+  }
+  framebuffer_.checkComplete();
+}
+
+int PatchTextures::bind(const gl::Program& program, const std::string& prefix, int firstUnit) const {
+  for (int slot = 0; slot < kAttachments; ++slot) {
+    texture(slot).bind(firstUnit + slot);
+    program.setSampler(samplerName(prefix, slot), firstUnit + slot);
+  }
+  return firstUnit + kAttachments;
+}
+
+void PatchTextures::upload(std::span<const PatchTexels> patches) {
+  if (patches.size() > capacity()) {
+    throw RuntimeError("PatchTextures::upload: " + std::to_string(patches.size()) + " patches in a list of " +
+                       std::to_string(capacity()));
+  }
+  const std::size_t texels = capacity();
+  std::vector<float> data(texels * 4);
+  for (int slot = 0; slot < kAttachments; ++slot) {
+    std::fill(data.begin(), data.end(), 0.0f);
+    for (std::size_t k = 0; k < patches.size(); ++k) {
+      const glm::ivec2 t = mortonTexel(static_cast<std::uint32_t>(k));
+      const std::size_t at = (static_cast<std::size_t>(t.y) * static_cast<std::size_t>(side_) +
+                              static_cast<std::size_t>(t.x)) * 4;
+      const glm::vec4& v = patches[k][static_cast<std::size_t>(slot)];
+      data[at + 0] = v.x;
+      data[at + 1] = v.y;
+      data[at + 2] = v.z;
+      data[at + 3] = v.w;
+    }
+    textures_[static_cast<std::size_t>(slot)].upload(data, 4);
+  }
+}
+
+std::vector<PatchTexels> PatchTextures::download(std::size_t count) const {
+  if (count > capacity()) count = capacity();
+  std::vector<PatchTexels> patches(count);
+  for (int slot = 0; slot < kAttachments; ++slot) {
+    const std::vector<float> data = texture(slot).download(4);
+    for (std::size_t k = 0; k < count; ++k) {
+      const glm::ivec2 t = mortonTexel(static_cast<std::uint32_t>(k));
+      const std::size_t at = (static_cast<std::size_t>(t.y) * static_cast<std::size_t>(side_) +
+                              static_cast<std::size_t>(t.x)) * 4;
+      patches[k][static_cast<std::size_t>(slot)] = {data[at], data[at + 1], data[at + 2], data[at + 3]};
+    }
+  }
+  return patches;
+}
+
+}  // namespace eik

@@ -1,0 +1,215 @@
+// Wavefront patches: the state of the light simulator and the pieces of one step that both back
+// ends share (lightsim/ALGORITHM.md; thesis §4.2.3, §6.2). The CPU twin (cpu_simulator.h) is built
+// from these functions, and the GPU path (gpu_simulator.h) uses them for its initial patch list and
+// as the reference its shaders must agree with:
+//  - Patch and its derived quantities (ALGORITHM.md "Patch state");
+//  - VolumeSampler: n, ∇n and σa sampled exactly like GL texture() ("Units and inputs");
+//  - initialPatches: directional and point lights ("Initialisation", thesis §6.2.1);
+//  - splitPatch: the 2×2 bilinear split ("One step", 6; Fig. 4.3);
+//  - fresnelReflectance (seeds/README.md), ray–box tests and the run's constants.
+//
+// Everything here is double precision. The GPU stores the same quantities in float, so the two
+// agree to float rounding, not bit for bit.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/grid.h"
+#include "core/volume.h"
+#include "lightsim/simulator.h"
+
+namespace eik {
+
+// ---------------------------------------------------------------------------------------------
+// Patch state (ALGORITHM.md "Patch state").
+
+// lum(c) = (r + g + b)/3, the grey value used for the direction sum and the `max` deposit.
+inline double luminance(const glm::dvec3& c) { return (c.x + c.y + c.z) / 3.0; }
+
+// Four corner particles, counter-clockwise seen from the side the light comes from, so that the
+// area vector N = ½ (x₂ − x₀) × (x₃ − x₁) points along the propagation.
+struct Patch {
+  std::array<glm::dvec3, 4> x{};  // corner positions
+  std::array<glm::dvec3, 4> w{};  // corner directions, |w_c| = n(x_c) (Eq. 4.12/4.13)
+  glm::dvec3 flux{0.0};           // Φ in W per channel; Φ = E·A (intensity law, Eq. 4.15/4.16)
+  double area0 = 0.0;             // A₀, the area at creation (initialisation or split)
+  int depth = 0;                  // splits since initialisation
+  double n_in = 0.0;              // n before the boundary layer the patch is in; 0: not in a layer
+  double cos_in = 0.0;            // |cos θ| of incidence on entering that layer
+  double t_fresnel = 1.0;         // 1 − R applied in the last step (1 when none)
+
+  // m = ¼ Σ x_c
+  glm::dvec3 midpoint() const { return 0.25 * (x[0] + x[1] + x[2] + x[3]); }
+  // d = normalize(Σ w_c)
+  glm::dvec3 direction() const { return glm::normalize(w[0] + w[1] + w[2] + w[3]); }
+  // N = ½ (x₂ − x₀) × (x₃ − x₁); |N| is the area of the (possibly non-planar) quadrilateral.
+  glm::dvec3 areaVector() const { return 0.5 * glm::cross(x[2] - x[0], x[3] - x[1]); }
+  double area() const { return glm::length(areaVector()); }
+  // Longest of the four sides x₀x₁, x₁x₂, x₂x₃, x₃x₀ (the split criterion, step 5).
+  double longestEdge() const {
+    double e = 0.0;
+    for (int c = 0; c < 4; ++c) e = std::max(e, glm::length(x[(c + 1) % 4] - x[c]));
+    return e;
+  }
+  // E = Φ / A (Eq. 4.16); 0 for a degenerate patch.
+  glm::dvec3 irradiance() const {
+    const double a = area();
+    return a > 0.0 ? flux / a : glm::dvec3(0.0);
+  }
+};
+
+// ---------------------------------------------------------------------------------------------
+// Sampling the volume (ALGORITHM.md "Units and inputs").
+
+// h: the smallest voxel edge.
+double voxelEdge(const GridSpec& grid);
+
+// The eight texels and weights of one lookup with GL_LINEAR filtering and GL_CLAMP_TO_EDGE: the
+// texture coordinate uvw = (x − bounds_min)/extent, the continuous voxel coordinate
+// c = uvw·dims − 0.5, clamped to [0, dims − 1] per axis (which is what clamp-to-edge does to the
+// filter footprint), i₀ = floor(c), i₁ = min(i₀ + 1, dims − 1), f = c − i₀.
+struct TrilinearTaps {
+  std::array<std::size_t, 8> index{};  // voxel indices, corner k = (kx + 2·ky + 4·kz)
+  std::array<double, 8> weight{};      // Π (kα ? f_α : 1 − f_α)
+};
+TrilinearTaps trilinearTaps(const GridSpec& grid, const glm::dvec3& world);
+
+// Samples up to four components of `field` at a world point (missing components are 0).
+glm::dvec4 sampleTrilinear(const Field& field, const GridSpec& grid, const glm::dvec3& world);
+
+// n, ∇n and σa of a volume, sampled like the GPU's textures. Holds its own interleaved float copy
+// of the fields (n and ∇n together, so one lookup serves both); thread-safe for reading.
+class VolumeSampler {
+ public:
+  // Needs `ior` (1 component) and `ior_grad` (3); `sigma_a` (3) is optional (absent: σa = 0).
+  // Throws InputError naming the field otherwise.
+  explicit VolumeSampler(const Volume& volume);
+
+  const GridSpec& grid() const { return grid_; }
+  double h() const { return h_; }
+  bool hasAbsorption() const { return !sigma_a_.empty(); }
+
+  double ior(const glm::dvec3& world) const;
+  // n and ∇n from one lookup: (n, ∂n/∂x, ∂n/∂y, ∂n/∂z).
+  glm::dvec4 iorAndGradient(const glm::dvec3& world) const;
+  glm::dvec3 sigmaA(const glm::dvec3& world) const;
+
+ private:
+  GridSpec grid_;
+  double h_ = 0.0;
+  std::vector<glm::vec4> ior_grad_;  // (n, ∇n) per voxel
+  std::vector<glm::vec3> sigma_a_;   // empty: no absorption
+};
+
+// ---------------------------------------------------------------------------------------------
+// Geometry.
+
+// Inside the closed box [lo, hi].
+bool insideBox(const glm::dvec3& p, const glm::dvec3& lo, const glm::dvec3& hi);
+// Does the ray origin + t·dir, t ≥ 0, meet the closed box [lo, hi]? (Slab test; an origin inside
+// counts as a hit; dir need not be unit.)
+bool rayHitsBox(const glm::dvec3& origin, const glm::dvec3& dir, const glm::dvec3& lo, const glm::dvec3& hi);
+
+// The bilinear patch through corners x₀ = (0,0), x₁ = (1,0), x₂ = (1,1), x₃ = (0,1) at (u, v).
+glm::dvec3 bilinear(const std::array<glm::dvec3, 4>& c, double u, double v);
+
+// Parameter origin (u_j, v_j) of child j of a split: (0,0), (½,0), (0,½), (½,½) (step 6; the
+// histogram pyramid's child order 0: (0,0), 1: (1,0), 2: (0,1), 3: (1,1)).
+constexpr std::array<std::array<double, 2>, 4> kSplitChildOrigin{{{0.0, 0.0}, {0.5, 0.0}, {0.0, 0.5}, {0.5, 0.5}}};
+
+// The 2×2 split of ALGORITHM.md step 6: corners and w from the bilinear patch at (u, v) ∈ {0,½,1}²,
+// w renormalised to n at the new corner, Φ_child = Φ·A_child/Σ A_children (flux conserved),
+// depth + 1, A₀ = A_child, n_in/cos_in/t_fresnel inherited.
+std::array<Patch, 4> splitPatch(const Patch& parent, const VolumeSampler& sampler);
+
+// w scaled to length n (the renormalisation after each update and split); w unchanged if 0.
+inline glm::dvec3 renormalised(const glm::dvec3& w, double n) {
+  const double len = glm::length(w);
+  return len > 0.0 ? w * (n / len) : w;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Fresnel (seeds/README.md, corrected Eq. 3.6): unpolarised reflectance R = (Rs + Rp)/2 for light
+// going from index n1 into n2 at incidence cos θᵢ (|cos_i| is used), 1 beyond the critical angle.
+double fresnelReflectance(double n1, double n2, double cos_i);
+
+// The reflectance a patch gets on leaving a boundary layer (ALGORITHM.md step 3, with two
+// decisions this file makes where ALGORITHM.md is silent or wrong; see the .cpp for the numbers):
+//  1. |n_out − n_in| < index_tolerance (boundary_off): no interface was crossed — the patch skimmed
+//     the layer or was turned back by the ray equation (total internal reflection) — so R = 0.
+//     ALGORITHM.md says "R ≈ 0" here, but the exact formula gives R → 1 for grazing patches that
+//     skim the tail of a layer (n 1.003 → 1.001 at cos θ = 0.05 is beyond the "critical angle").
+//  2. Otherwise R is evaluated on the side of lower index: R(n_in → n_out, cos_in) when
+//     n_in ≤ n_out, else R(n_out → n_in, cos_out) (reciprocity: the same R for Snell-paired
+//     angles). A smoothed boundary is several voxels thick and curved, so the angle measured at the
+//     layer's inner edge is not the sharp interface's: on a smoothed sphere n·r·sin θ is conserved
+//     across the layer (Bouguer), and rays that leave the sphere perfectly well meet the inner edge
+//     beyond the critical angle — evaluating R there returned R = 1 for them.
+// cos_out = |d_new·∇n̂(m_new)| at the point where the patch left the layer; < 0 when ∇n = 0 there
+// (then the n_in side is used).
+double boundaryReflectance(double n_in, double cos_in, double n_out, double cos_out, double index_tolerance);
+
+// ---------------------------------------------------------------------------------------------
+// Initialisation (ALGORITHM.md "Initialisation", thesis §6.2.1).
+
+// Right-handed orthonormal (u, v) ⟂ L with u × v = L (L unit): u = normalize(e × L) with e the
+// axis of L's smallest |component| (first of x, y, z on ties), v = L × u.
+void orthonormalBasis(const glm::dvec3& L, glm::dvec3& u, glm::dvec3& v);
+
+// Exact solid angle of the cube-face cell [a0, a1] × [b0, b1] on the face at distance 1:
+// Ω = F(a1,b1) − F(a0,b1) − F(a1,b0) + F(a0,b0), F(a, b) = atan2(ab, sqrt(a² + b² + 1)).
+double cubeCellSolidAngle(double a0, double b0, double a1, double b1);
+
+// Cube-map faces: face f has outward normal n_f and tangents (s_f, t_f) with s_f × t_f = n_f; the
+// point (a, b) ∈ [−1, 1]² of the face is n_f + a·s_f + b·t_f. Order +X, −X, +Y, −Y, +Z, −Z.
+struct CubeFace {
+  glm::dvec3 normal, s, t;
+};
+const std::array<CubeFace, 6>& cubeFaces();
+
+// Point light: initial wavefront radius r₀ = max(ε, dist(p, box) − h), ε = ½h (ε inside the box),
+// and the cube-map resolution M = clamp(ceil(2·r₀/(patch_voxels·h)), 1, 2048): a cell's chord at
+// r₀ is then at most patch_voxels·h (the largest cell, at a face centre, subtends atan(2/M) < 2/M).
+double pointLightStartRadius(const glm::dvec3& position, const GridSpec& grid);
+int pointLightCubeResolution(double start_radius, const GridSpec& grid, const SimulationOptions& options);
+constexpr int kMaxCubeResolution = 2048;
+
+// The initial patch list, in the order both back ends use:
+//  - directional: the covering rectangle of the box's projection, on the plane through the box
+//    corner first along L moved back by ½h, cut into Nu × Nv patches (edges ≤ patch_voxels·h),
+//    row by row (iv outer, iu inner), keeping those whose midpoint ray hits the box. w = n·L,
+//    Φ = E_L·A.
+//  - point: the cube map face by face (+X … −Z), then rows (j outer, i inner), keeping the cells
+//    whose centre ray from p hits the box; corners p + r₀·dir, w = n·dir, Φ = I·Ω_cell.
+// A₀ = A, depth 0, n_in = 0. `flux_ref` (if not null) receives Φ_ref, the largest channel of the
+// largest initial patch flux (0 when the list is empty). An empty list means the light misses the
+// volume: a point light so far away that the box falls between the centre rays of the finest cube
+// map (M = 2048). A directional light always meets the box. Zero power is allowed here (patches
+// that carry nothing); parseLight rejects it. Throws InputError for an unusable light (zero or non-finite direction or position,
+// negative or non-finite power) and for bad options (validateOptions).
+std::vector<Patch> initialPatches(const LightSpec& light, const GridSpec& grid, const VolumeSampler& sampler,
+                                  const SimulationOptions& options, double* flux_ref);
+
+// ---------------------------------------------------------------------------------------------
+// Constants of a run.
+
+// Throws InputError ("lightsim options: NAME: ...") for a value out of range: a non-positive or
+// non-finite step, patch or split size; max_depth < 0 or > 16; a negative threshold or max_steps;
+// negative boundary thresholds or boundary_off > boundary_on.
+void validateOptions(const SimulationOptions& options);
+// Δt = step_voxels·h.
+double timeStep(const GridSpec& grid, const SimulationOptions& options);
+// options.max_steps, or when 0: ceil(4 × grid diagonal / Δt).
+int maxSteps(const GridSpec& grid, const SimulationOptions& options);
+// The flux kill threshold of step 5: flux_threshold · Φ_ref / 4^depth.
+inline double fluxKillThreshold(double flux_ref, const SimulationOptions& options, int depth) {
+  return options.flux_threshold * flux_ref * std::ldexp(1.0, -2 * depth);
+}
+
+}  // namespace eik
