@@ -187,6 +187,7 @@ GridUniforms GridUniforms::from(const GridSpec& grid) {
   const glm::dvec3 h = grid.voxelSize();
   u.voxelEdge = static_cast<float>(std::min({h.x, h.y, h.z}));
   u.voxelVolume = static_cast<float>(grid.voxelVolume());
+  u.dims = grid.dims;
   return u;
 }
 
@@ -196,36 +197,33 @@ void GridUniforms::set(const gl::Program& program) const {
   program.set("uInvExtent", invExtent);
   program.set("uVoxelEdge", voxelEdge);
   program.set("uVoxelVolume", voxelVolume);
+  program.set("uDims", dims);
 }
 
-DepositPass::DepositPass(const gl::ShaderLibrary& library, const AtlasLayout& layout, DepositMode mode,
-                         const std::string& volumeDefines)
+DepositPass::DepositPass(const gl::ShaderLibrary& library, const AtlasLayout& layout, DepositMode mode)
     : vao_(gl::VertexArray::create()), mode_(mode) {
   gl::ShaderDefines defines = layout.defines();
   defines.emplace_back(mode == DepositMode::Max ? "DEPOSIT_MAX" : "DEPOSIT_ACCUMULATE", "1");
-  program_ = library.program("lightsim/deposit.vert", "lightsim/deposit.frag", defines, volumeDefines);
+  program_ = library.program("lightsim/deposit.vert", "lightsim/deposit.frag", defines);
 }
 
-void DepositPass::run(const PatchTextures& patches, const PatchTextures& previous, std::size_t count,
-                      AtlasTargets& atlas, const gl::VolumeTextures& volume, const GridUniforms& grid, float dt,
-                      float energyRef) const {
+void DepositPass::run(const gl::Texture2D& depositA, const gl::Texture2D& depositB, std::size_t count,
+                      AtlasTargets& atlas, float energyRef) const {
   if (count == 0) return;
   ScopedPassBindings unbind;
   atlas.framebuffer().bind();
   program_.use();
-  int unit = patches.bind(program_, "uPatch", 0);
-  if (mode_ == DepositMode::Accumulate) unit = previous.bind(program_, "uPrevious", unit);
-  volume.bind(program_, unit);
-  grid.set(program_);
-  program_.set("uDt", dt);
+  depositA.bind(0);
+  program_.setSampler("uDepositA", 0);
+  depositB.bind(1);
+  program_.setSampler("uDepositB", 1);
   program_.set("uEnergyRef", energyRef);
+  vao_.bind();
   if (mode_ == DepositMode::Accumulate) {
     ScopedBlendAdd blend;
-    vao_.bind();
     glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(count));
   } else {
     ScopedDepthTest depth(GL_LESS);
-    vao_.bind();
     glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(count));
   }
   gl::checkErrors("DepositPass");

@@ -28,8 +28,6 @@
 #include "gl/shader_library.h"
 #include "gl/texture.h"
 #include "gl/vertex_array.h"
-#include "gl/volume_textures.h"
-#include "lightsim/patch_textures.h"
 #include "lightsim/simulator.h"
 
 namespace eik {
@@ -124,21 +122,21 @@ struct GridUniforms {
   glm::vec3 invExtent{1.0f};  // uvw = (x − boundsMin) · invExtent
   float voxelEdge = 1.0f;     // h, the smallest voxel edge
   float voxelVolume = 1.0f;   // V_voxel
+  glm::ivec3 dims{1};         // for EXACT_TRILINEAR sampling
   static GridUniforms from(const GridSpec& grid);
   void set(const gl::Program& program) const;
 };
 
-// Step 4: one GL_POINTS primitive per live patch of `patches` into `atlas`.
+// Step 4: one GL_POINTS primitive per live patch into `atlas`. The analysis pass (gpu_simulator.h,
+// gpu::AnalysisPass) has computed each patch's deposit: depositA = (value, atlas x; x < 0: none),
+// depositB = (direction, atlas y), in the patch list layout (patch k at mortonTexel(k)).
 class DepositPass {
  public:
-  // volumeDefines: gl::VolumeTextureLayout::glslDefines() of the uploaded volume.
-  DepositPass(const gl::ShaderLibrary& library, const AtlasLayout& layout, DepositMode mode,
-              const std::string& volumeDefines);
-  // Deposits patches 0 .. count − 1. dt: the time step Δt (Δs_m = Δt / n(m_old) is recomputed
-  // from `previous`, the list before the update: ALGORITHM.md step 2). energyRef: E_ref of the
-  // max-mode depth mapping (any positive scale of the irradiance).
-  void run(const PatchTextures& patches, const PatchTextures& previous, std::size_t count, AtlasTargets& atlas,
-           const gl::VolumeTextures& volume, const GridUniforms& grid, float dt, float energyRef) const;
+  DepositPass(const gl::ShaderLibrary& library, const AtlasLayout& layout, DepositMode mode);
+  // Deposits patches 0 .. count − 1. energyRef: E_ref of the max-mode depth mapping (a positive
+  // irradiance well below the ones that matter).
+  void run(const gl::Texture2D& depositA, const gl::Texture2D& depositB, std::size_t count, AtlasTargets& atlas,
+           float energyRef) const;
 
  private:
   gl::Program program_;

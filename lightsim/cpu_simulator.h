@@ -9,7 +9,7 @@
 // the same order).
 #pragma once
 
-#include <span>
+#include <array>
 
 #include "core/volume.h"
 #include "lightsim/simulator.h"
@@ -17,16 +17,17 @@
 
 namespace eik {
 
-// A diagnostic of the CPU twin: the flux that patch midpoints carry across the plane
-// x[axis] = coordinate, counted once per crossing with the patch's flux after that step. Exact
-// (no voxel sampling), so tests can check the deposit-free energy flow; see test_scenes.h for the
-// bake-level measure.
-struct PlaneFluxProbe {
-  int axis = 1;                        // 0: x, 1: y, 2: z
-  double coordinate = 0.0;
-  glm::dvec3 to_positive{0.0};         // crossed towards +axis (W, RGB)
-  glm::dvec3 to_negative{0.0};         // crossed towards −axis
+// Diagnostics of the CPU twin that SimulationStats does not carry.
+struct CpuRunDiagnostics {
+  // The flux carried out of the grid by exiting patches, by the face they left through
+  // (exitFace): 0: −x, 1: +x, 2: −y, 3: +y, 4: −z, 5: +z (W, RGB). Sums to stats.flux_out.
+  std::array<glm::dvec3, 6> flux_out_by_face{};
 };
+
+// The face of the grid box a patch at midpoint m (outside the box) heading along d left through:
+// the face where the backward ray m − t·d enters the box, or, if that ray misses it (a path bent
+// outside the box), the face the point lies farthest beyond (relative to the box's extent).
+int exitFace(const glm::dvec3& m, const glm::dvec3& d, const GridSpec& grid);
 
 class CpuSimulator : public Simulator {
  public:
@@ -37,8 +38,8 @@ class CpuSimulator : public Simulator {
   // Runs one bake. Throws InputError for a bad light or bad options (validateOptions). A light that
   // misses the volume gives all-zero fields and stats.initial_patches = 0 (lightMissedVolume).
   BakeResult run(const LightSpec& light, const SimulationOptions& options) override;
-  // The same, also filling the probes (their flux sums are reset first).
-  BakeResult run(const LightSpec& light, const SimulationOptions& options, std::span<PlaneFluxProbe> probes);
+  // The same, also filling `diagnostics` (when not null).
+  BakeResult run(const LightSpec& light, const SimulationOptions& options, CpuRunDiagnostics* diagnostics);
 
   const VolumeSampler& sampler() const { return sampler_; }
 
@@ -58,7 +59,6 @@ struct PatchStepResult {
   double max_key = 0.0;            // max: lum(E)
   glm::dvec3 absorbed{0.0};        // Φ·(1 − exp(−σa·Δs_m))
   glm::dvec3 reflected{0.0};       // R·Φ on leaving a boundary layer
-  glm::dvec3 old_midpoint{0.0};    // m before the step
 };
 
 struct StepContext {
@@ -71,8 +71,21 @@ struct StepContext {
 
 PatchStepResult stepPatch(Patch& patch, const StepContext& context);
 
+// What the CPU twin carries from one step to the next so as not to sample the same points twice:
+// iorAndGradient at the four corners and n at the midpoint (the values at the end of a step are
+// those at the start of the next). Caching changes no bit of the result.
+struct PatchSamples {
+  std::array<glm::dvec4, 4> corner{};
+  double n_mid = 1.0;
+};
+PatchSamples samplePatch(const Patch& patch, const VolumeSampler& sampler);
+// stepPatch with the samples at the patch's current corners and midpoint; updates them.
+PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext& context);
+
 // The integrators of step 1 on the right-hand side (w/n², ∇n/n) (Eq. 4.12/4.13; Euler is
-// Eq. 6.1/6.2), followed by the renormalisation |w| = n(x_new).
-void advanceCorner(glm::dvec3& x, glm::dvec3& w, double dt, Integrator integrator, const VolumeSampler& sampler);
+// Eq. 6.1/6.2), followed by the renormalisation |w| = n(x_new). `sample` holds iorAndGradient(x)
+// on entry and iorAndGradient(x_new) on return.
+void advanceCorner(glm::dvec3& x, glm::dvec3& w, glm::dvec4& sample, double dt, Integrator integrator,
+                   const VolumeSampler& sampler);
 
 }  // namespace eik

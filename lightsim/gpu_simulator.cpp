@@ -5,8 +5,8 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <map>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -69,7 +69,7 @@ class PhaseTimer {
   // Ends the running phase and starts `name`.
   void start(const char* name) {
     stop();
-    if (mode_ == GpuSimulatorOptions::Timing::Off) return;
+    if (mode_ != GpuSimulatorOptions::Timing::Finish && mode_ != GpuSimulatorOptions::Timing::Queries) return;
     running_ = true;
     name_ = name;
     if (mode_ == GpuSimulatorOptions::Timing::Finish) {
@@ -134,100 +134,124 @@ class PhaseTimer {
 // Sets the viewport to the live box of a list (after Framebuffer::bind set it to the whole list).
 void viewportBox(glm::ivec2 box) { glViewport(0, 0, box.x, box.y); }
 
-// Constants of a step, as uniforms.
-struct StepUniforms {
-  float dt = 0.0f;
-  float boundaryOn = 0.0f, boundaryOff = 0.0f;
-  float fluxKill = 0.0f, splitLength = 0.0f, maxDepth = 0.0f;
-};
+const gl::Sampling kNearest{gl::Filter::Nearest, gl::Wrap::ClampToEdge};
+
+const char* integratorDefine(Integrator integrator) {
+  switch (integrator) {
+    case Integrator::RK4: return "INTEGRATOR_RK4";
+    case Integrator::RK2: return "INTEGRATOR_RK2";
+    case Integrator::Euler: break;
+  }
+  return "INTEGRATOR_EULER";
+}
+
+const char* depositDefine(DepositMode mode) { return mode == DepositMode::Max ? "DEPOSIT_MAX" : "DEPOSIT_ACCUMULATE"; }
+
+}  // namespace
 
 // ---------------------------------------------------------------------------------------------
-// Passes. Each takes its inputs and outputs explicitly and leaves no GL state behind but the
-// bindings its draw made (framebuffer, program, textures, VAO), which the next pass replaces.
+// Passes (gpu_simulator.h).
 
-// Steps 1–3: list `in` → list `out`.
-class UpdatePass {
- public:
-  UpdatePass(const gl::ShaderLibrary& library, Integrator integrator, const std::string& volumeDefines) {
-    const char* variant = integrator == Integrator::RK4   ? "INTEGRATOR_RK4"
-                          : integrator == Integrator::RK2 ? "INTEGRATOR_RK2"
-                                                          : "INTEGRATOR_EULER";
-    program_ = library.program("common/fullscreen.vert", "lightsim/update.frag", {{variant, "1"}}, volumeDefines);
+namespace gpu {
+
+StepTargets::StepTargets(int side, const gl::ShaderLibrary& library)
+    : pyramid(side, library),
+      depositA({side, side}, gl::TextureFormat::RGBA32F, kNearest),
+      depositB({side, side}, gl::TextureFormat::RGBA32F, kNearest),
+      ledgerA({side, side}, gl::TextureFormat::RGBA32F, kNearest),
+      ledgerB({side, side}, gl::TextureFormat::RGBA32F, kNearest),
+      framebuffer({side, side}) {
+  framebuffer.attach(0, pyramid.base());
+  framebuffer.attach(1, depositA);
+  framebuffer.attach(2, depositB);
+  framebuffer.attach(3, ledgerA);
+  framebuffer.attach(4, ledgerB);
+  framebuffer.checkComplete();
+}
+
+std::size_t StepTargets::bytesFor(int side) {
+  // Pyramid: R32F base + RGBA32F levels (16/3 B a slot); four RGBA32F targets.
+  const std::size_t texels = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
+  return texels * 4 + texels * 16 / 3 + 4 * texels * 16;
+}
+
+UpdatePass::UpdatePass(const gl::ShaderLibrary& library, Integrator integrator, const std::string& volumeDefines)
+    : program_(library.program("common/fullscreen.vert", "lightsim/update.frag", {{integratorDefine(integrator), "1"}},
+                               volumeDefines)) {}
+
+void UpdatePass::run(const PatchTextures& in, PatchTextures& out, std::size_t count, const gl::VolumeTextures& volume,
+                     const GridUniforms& grid, const StepUniforms& step) const {
+  ScopedPassBindings unbind;
+  out.framebuffer().bind();
+  viewportBox(mortonBox(count));
+  program_.use();
+  volume.bind(program_, in.bind(program_, "uPatch", 0));
+  grid.set(program_);
+  program_.set("uCount", static_cast<int>(count));
+  program_.set("uDt", step.dt);
+  program_.set("uBoundaryOn", step.boundaryOn);
+  program_.set("uBoundaryOff", step.boundaryOff);
+  triangle_.draw();
+  gl::checkErrors("UpdatePass");
+}
+
+AnalysisPass::AnalysisPass(const gl::ShaderLibrary& library, DepositMode mode, const AtlasLayout& atlas,
+                           const std::string& volumeDefines) {
+  gl::ShaderDefines defines = atlas.defines();
+  defines.emplace_back(depositDefine(mode), "1");
+  program_ = library.program("common/fullscreen.vert", "lightsim/analysis.frag", defines, volumeDefines);
+}
+
+void AnalysisPass::run(const PatchTextures& current, const PatchTextures& previous, std::size_t count,
+                       StepTargets& targets, const gl::VolumeTextures& volume, const GridUniforms& grid,
+                       const StepUniforms& step) const {
+  ScopedPassBindings unbind;
+  targets.framebuffer.bind();
+  viewportBox(mortonBox(count));
+  program_.use();
+  int unit = current.bind(program_, "uPatch", 0);  // 8 units
+  for (int c = 0; c < 4; ++c, ++unit) {
+    previous.texture(PatchTextures::kP0 + c).bind(unit);
+    program_.setSampler("uPrevious[" + std::to_string(c) + "]", unit);
   }
-  void run(const PatchTextures& in, PatchTextures& out, std::size_t count, const gl::VolumeTextures& volume,
-           const GridUniforms& grid, const StepUniforms& step, const gl::FullscreenTriangle& triangle) const {
-    out.framebuffer().bind();
-    viewportBox(mortonBox(count));
-    program_.use();
-    volume.bind(program_, in.bind(program_, "uPatch", 0));
-    grid.set(program_);
-    program_.set("uCount", static_cast<int>(count));
-    program_.set("uDt", step.dt);
-    program_.set("uBoundaryOn", step.boundaryOn);
-    program_.set("uBoundaryOff", step.boundaryOff);
-    triangle.draw();
-    gl::checkErrors("UpdatePass");
-  }
+  previous.texture(PatchTextures::kFlux).bind(unit);
+  program_.setSampler("uPreviousFlux", unit++);
+  volume.bind(program_, unit);  // at most 2 (optics, absorption): 15 of the 16 units GL 3.3 guarantees
+  grid.set(program_);
+  program_.set("uCount", static_cast<int>(count));
+  program_.set("uDt", step.dt);
+  program_.set("uFluxKill", step.fluxKill);
+  program_.set("uSplitLength", step.splitLength);
+  program_.set("uMaxDepth", step.maxDepth);
+  triangle_.draw();
+  gl::checkErrors("AnalysisPass");
+}
 
- private:
-  gl::Program program_;
-};
+CompactPass::CompactPass(const gl::ShaderLibrary& library, const gl::ShaderDefines& pyramidDefines,
+                         const std::string& volumeDefines)
+    : program_(library.program("common/fullscreen.vert", "lightsim/compact.frag", pyramidDefines, volumeDefines)) {}
 
-// Step 5: counts into the pyramid's base, fate codes into `fate`.
-class AnalysisPass {
- public:
-  AnalysisPass(const gl::ShaderLibrary& library, DepositMode mode, const std::string& volumeDefines)
-      : program_(library.program("common/fullscreen.vert", "lightsim/analysis.frag",
-                                 {{mode == DepositMode::Max ? "DEPOSIT_MAX" : "DEPOSIT_ACCUMULATE", "1"}},
-                                 volumeDefines)) {}
-  void run(const PatchTextures& list, std::size_t count, gl::Framebuffer& target, const gl::VolumeTextures& volume,
-           const GridUniforms& grid, const StepUniforms& step, const gl::FullscreenTriangle& triangle) const {
-    target.bind();
-    viewportBox(mortonBox(count));
-    program_.use();
-    volume.bind(program_, list.bind(program_, "uPatch", 0));
-    grid.set(program_);
-    program_.set("uCount", static_cast<int>(count));
-    program_.set("uFluxKill", step.fluxKill);
-    program_.set("uSplitLength", step.splitLength);
-    program_.set("uMaxDepth", step.maxDepth);
-    triangle.draw();
-    gl::checkErrors("AnalysisPass");
-  }
+void CompactPass::run(const PatchTextures& in, const StepTargets& targets, PatchTextures& out, std::size_t total,
+                      const gl::VolumeTextures& volume, const GridUniforms& grid) const {
+  ScopedPassBindings unbind;
+  out.framebuffer().bind();
+  viewportBox(mortonBox(total));
+  program_.use();
+  int unit = in.bind(program_, "uPatch", 0);
+  targets.pyramid.bind(unit);
+  program_.setSampler("uPyramid", unit++);
+  targets.ledgerA.bind(unit);
+  program_.setSampler("uLedgerA", unit++);
+  volume.bind(program_, unit);
+  grid.set(program_);
+  program_.set("uTotal", static_cast<int>(total));
+  triangle_.draw();
+  gl::checkErrors("CompactPass");
+}
 
- private:
-  gl::Program program_;
-};
+}  // namespace gpu
 
-// Step 6: list `in` (+ pyramid over its counts) → list `out` of `total` patches.
-class CompactPass {
- public:
-  CompactPass(const gl::ShaderLibrary& library, const HistoPyramid& pyramid, const std::string& volumeDefines)
-      : levels_(pyramid.levels()),
-        program_(library.program("common/fullscreen.vert", "lightsim/compact.frag", pyramid.defines(), volumeDefines)) {}
-  int levels() const { return levels_; }
-  void run(const PatchTextures& in, const HistoPyramid& pyramid, const gl::Texture2D& fate, PatchTextures& out,
-           std::size_t total, const gl::VolumeTextures& volume, const GridUniforms& grid,
-           const gl::FullscreenTriangle& triangle) const {
-    out.framebuffer().bind();
-    viewportBox(mortonBox(total));
-    program_.use();
-    int unit = in.bind(program_, "uPatch", 0);
-    pyramid.bind(unit);
-    program_.setSampler("uPyramid", unit++);
-    fate.bind(unit);
-    program_.setSampler("uFate", unit++);
-    volume.bind(program_, unit);
-    grid.set(program_);
-    program_.set("uTotal", static_cast<int>(total));
-    triangle.draw();
-    gl::checkErrors("CompactPass");
-  }
-
- private:
-  int levels_;
-  gl::Program program_;
-};
+namespace {
 
 // The energy ledger: kLedgerColumns RGBA32F targets of kBins × rows texels, one row per step,
 // summed with additive blending (one point per patch writes all its entries, MRT), read back and
@@ -236,34 +260,40 @@ class Ledger {
  public:
   static constexpr int kBins = 256;  // texels per row (patch k adds into bin k mod kBins)
 
-  Ledger(const gl::ShaderLibrary& library, const std::string& volumeDefines, int rows)
+  Ledger(const gl::ShaderLibrary& library, int rows)
       : rows_(std::max(1, rows)),
         target_({kBins, rows_}, std::vector<gl::TextureFormat>(kLedgerColumns, gl::TextureFormat::RGBA32F)),
-        step_(library.program("lightsim/ledger.vert", "lightsim/ledger.frag", {}, volumeDefines)),
-        unfinished_(library.program("lightsim/ledger.vert", "lightsim/ledger.frag", {{"LEDGER_UNFINISHED", "1"}},
-                                    volumeDefines)),
+        step_(library.program("lightsim/ledger.vert", "lightsim/ledger.frag")),
+        unfinished_(library.program("lightsim/ledger.vert", "lightsim/ledger.frag", {{"LEDGER_UNFINISHED", "1"}})),
         vao_(gl::VertexArray::create()) {
     clear();
   }
 
   bool full() const { return row_ == rows_; }
+  // Zero sums and rows, for a new run.
+  void reset() {
+    clear();
+    row_ = 0;
+    sums_ = {};
+  }
 
-  // Entries of one step: absorbed and reflected (from `previous` → `current`), fates.
-  void addStep(const PatchTextures& previous, const PatchTextures& current, const gl::Texture2D& fate,
-               std::size_t count, const gl::VolumeTextures& volume, const GridUniforms& grid, float dt) {
+  // The entries of one step, from the analysis of the updated list `current`.
+  void addStep(const gpu::StepTargets& targets, const PatchTextures& current, std::size_t count) {
     draw(step_, [&] {
-      int unit = current.bind(step_, "uPatch", 0);
-      unit = previous.bind(step_, "uPrevious", unit);
-      fate.bind(unit);
-      step_.setSampler("uFate", unit);
-      volume.bind(step_, unit + 1);
-      grid.set(step_);
-      step_.set("uDt", dt);
+      targets.ledgerA.bind(0);
+      step_.setSampler("uLedgerA", 0);
+      targets.ledgerB.bind(1);
+      step_.setSampler("uLedgerB", 1);
+      current.texture(PatchTextures::kFlux).bind(2);
+      step_.setSampler("uFlux", 2);
     }, count);
   }
   // The flux of the patches still alive at the end.
   void addUnfinished(const PatchTextures& list, std::size_t count) {
-    draw(unfinished_, [&] { list.bind(unfinished_, "uPatch", 0); }, count);
+    draw(unfinished_, [&] {
+      list.texture(PatchTextures::kFlux).bind(0);
+      unfinished_.setSampler("uFlux", 0);
+    }, count);
   }
 
   // Reads the rows written so far, adds them to the sums and clears them.
@@ -291,6 +321,7 @@ class Ledger {
   void draw(const gl::Program& program, Setup&& setup, std::size_t points) {
     if (full()) flush();
     if (points > 0) {
+      ScopedPassBindings unbind;
       target_.bind();
       program.use();
       setup();
@@ -314,27 +345,16 @@ class Ledger {
   std::array<glm::dvec4, kLedgerColumns> sums_{};
 };
 
-// The patch list of one side, with the targets of the analysis: the pyramid (whose base takes the
-// counts) and the fate codes.
+// The two patch lists of one side and the targets of their analysis.
 struct ListSet {
   PatchTextures a, b;  // a: the current list; b: the updated one
-  HistoPyramid pyramid;
-  gl::Texture2D fate;
-  gl::Framebuffer analysis;  // pyramid base (0) and fate (1)
+  gpu::StepTargets targets;
 
-  ListSet(int side, const gl::ShaderLibrary& library)
-      : a(side), b(side), pyramid(side, library),
-        fate({side, side}, gl::TextureFormat::R32F, gl::Sampling{gl::Filter::Nearest, gl::Wrap::ClampToEdge}),
-        analysis({side, side}) {
-    analysis.attach(0, pyramid.base());
-    analysis.attach(1, fate);
-    analysis.checkComplete();
-  }
+  ListSet(int side, const gl::ShaderLibrary& library) : a(side), b(side), targets(side, library) {}
   int side() const { return a.side(); }
   static std::size_t bytesFor(int side) {
     const std::size_t texels = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
-    // Two lists of 8 RGBA32F, the pyramid (R32F base + RGBA32F levels, 16/3 B a slot), fate (R32F).
-    return 2 * texels * PatchTextures::kAttachments * 16 + texels * 4 + texels * 16 / 3 + texels * 4;
+    return 2 * texels * PatchTextures::kAttachments * 16 + gpu::StepTargets::bytesFor(side);
   }
 };
 
@@ -353,47 +373,77 @@ Volume simulationFields(const Volume& volume) {
 // ---------------------------------------------------------------------------------------------
 
 struct GpuSimulator::Impl {
-  GpuSimulatorOptions options;
+  GpuSimulatorOptions config;
   GridSpec grid;
-  VolumeSampler sampler;  // the CPU twin's sampler, for initialPatches
+  std::string renderer;
+  AtlasLayout atlasLayout;  // planned (and the memory checked) before anything is uploaded
+  int maxSide = 0;
+  VolumeSampler sampler;    // the CPU twin's sampler, for initialPatches
   gl::ShaderLibrary library;
   gl::VolumeTextures volume;
   std::string volumeDefines;
-  AtlasLayout atlasLayout;
+  // The GPU works in grid-local coordinates, x − centre of the grid, so float positions keep their
+  // precision however far the volume sits from the world origin.
+  glm::dvec3 origin{0.0};
   GridUniforms gridUniforms;
-  gl::FullscreenTriangle triangle;
-  int maxSide = 0;
-  std::string renderer;
   GpuRunInfo info;
 
   // Programs, made on first use and kept across runs.
-  std::map<Integrator, std::unique_ptr<UpdatePass>> updates;
+  std::map<Integrator, std::unique_ptr<gpu::UpdatePass>> updates;
   std::map<DepositMode, std::unique_ptr<DepositPass>> deposits;
-  std::map<DepositMode, std::unique_ptr<AnalysisPass>> analyses;
-  std::map<int, std::unique_ptr<CompactPass>> compacts;  // by pyramid levels
+  std::map<DepositMode, std::unique_ptr<gpu::AnalysisPass>> analyses;
+  std::map<int, std::unique_ptr<gpu::CompactPass>> compacts;  // by pyramid levels
+  std::unique_ptr<Ledger> ledger;
 
   Impl(const Volume& v, const GpuSimulatorOptions& o)
-      : options(o), grid(v.grid), sampler(v), volume(uploadVolume(v, o)),
-        volumeDefines(volume.layout().glslDefines()) {
-    const gl::GlContext& context = gl::detail::requireContext("the GPU light simulator");
-    renderer = context.summary();
-    atlasLayout = AtlasLayout::plan(grid.dims, context.info().maxTextureSize, o.source, context.info().renderer);
-    gridUniforms = GridUniforms::from(grid);
-    maxSide = 1;
-    const int limit = std::min({std::max(1, o.max_patch_side), context.info().maxTextureSize,
-                                HistoPyramidLimits::kMaxBaseSize});
-    while (maxSide * 2 <= limit) maxSide *= 2;
+      : config(o),
+        grid(v.grid),
+        renderer(gl::detail::requireContext("the GPU light simulator").summary()),
+        atlasLayout(planAtlas(v, o)),
+        maxSide(patchListLimit(o)),
+        sampler(v),
+        volume(uploadVolume(v, o)),
+        volumeDefines(volume.layout().glslDefines() + (o.exact_sampling ? "#define EXACT_TRILINEAR 1\n" : "")),
+        origin(0.5 * (grid.bounds_min + grid.bounds_max)),
+        gridUniforms(GridUniforms::from(localGrid(grid, origin))) {}
+
+  static GridSpec localGrid(GridSpec g, const glm::dvec3& origin) {
+    g.bounds_min -= origin;
+    g.bounds_max -= origin;
+    return g;
+  }
+
+  // The atlas layout; InputError "volume too large for the GPU" when it does not fit
+  // GL_MAX_TEXTURE_SIZE, or when the fields, the atlas and the smallest patch lists do not fit the
+  // texture budget (checked before uploading anything).
+  static AtlasLayout planAtlas(const Volume& v, const GpuSimulatorOptions& o) {
+    const gl::GlContext& context = *gl::GlContext::current();
+    const AtlasLayout layout = AtlasLayout::plan(v.grid.dims, context.info().maxTextureSize, o.source,
+                                                 context.info().renderer);
+    // Optics (n, ∇n) RGBA32F, absorption (σa) RGB32F: gl/volume_textures.h.
+    const std::size_t fields =
+        v.grid.count() * ((v.has("ior") || v.has("ior_grad") ? 16 : 0) + (v.has("sigma_a") ? 12 : 0));
     const std::size_t budget = o.budget_bytes ? o.budget_bytes : gl::defaultTextureBudget();
-    const std::size_t needed = volume.bytes() + AtlasTargets::bytesFor(atlasLayout, DepositMode::Max) +
-                               ListSet::bytesFor(64);
+    const std::size_t needed = fields + AtlasTargets::bytesFor(layout, DepositMode::Max) + ListSet::bytesFor(64);
     if (needed > budget) {
       throw InputError(o.source, "dims",
-                       "volume too large for the GPU: the light simulator needs " + bytesText(needed) +
-                           " of texture memory for a grid of " + std::to_string(grid.dims.x) + "x" +
-                           std::to_string(grid.dims.y) + "x" + std::to_string(grid.dims.z) +
+                       "volume too large for the GPU: the light simulator needs at least " + bytesText(needed) +
+                           " of texture memory for a grid of " + std::to_string(v.grid.dims.x) + "x" +
+                           std::to_string(v.grid.dims.y) + "x" + std::to_string(v.grid.dims.z) +
                            " voxels (fields, flat-3D atlas, patch lists), over the budget of " + bytesText(budget) +
                            " (EIKONAL_GL_TEXTURE_BUDGET_MB)");
     }
+    return layout;
+  }
+
+  // The largest power-of-two list side allowed: max_patch_side, GL_MAX_TEXTURE_SIZE and the
+  // pyramid's limit.
+  static int patchListLimit(const GpuSimulatorOptions& o) {
+    const int limit = std::min({std::max(1, o.max_patch_side), gl::GlContext::current()->info().maxTextureSize,
+                                HistoPyramidLimits::kMaxBaseSize});
+    int side = 1;
+    while (side * 2 <= limit) side *= 2;
+    return side;
   }
 
   static gl::VolumeTextures uploadVolume(const Volume& v, const GpuSimulatorOptions& o) {
@@ -403,25 +453,36 @@ struct GpuSimulator::Impl {
     return gl::VolumeTextures(simulationFields(v), vo);
   }
 
-  UpdatePass& update(Integrator i) {
+  gpu::UpdatePass& update(Integrator i) {
     auto& p = updates[i];
-    if (!p) p = std::make_unique<UpdatePass>(library, i, volumeDefines);
+    if (!p) p = std::make_unique<gpu::UpdatePass>(library, i, volumeDefines);
     return *p;
   }
   DepositPass& deposit(DepositMode m) {
     auto& p = deposits[m];
-    if (!p) p = std::make_unique<DepositPass>(library, atlasLayout, m, volumeDefines);
+    if (!p) p = std::make_unique<DepositPass>(library, atlasLayout, m);
     return *p;
   }
-  AnalysisPass& analyse(DepositMode m) {
+  gpu::AnalysisPass& analyse(DepositMode m) {
     auto& p = analyses[m];
-    if (!p) p = std::make_unique<AnalysisPass>(library, m, volumeDefines);
+    if (!p) p = std::make_unique<gpu::AnalysisPass>(library, m, atlasLayout, volumeDefines);
     return *p;
   }
-  CompactPass& compact(const HistoPyramid& pyramid) {
+  gpu::CompactPass& compact(const HistoPyramid& pyramid) {
     auto& p = compacts[pyramid.levels()];
-    if (!p) p = std::make_unique<CompactPass>(library, pyramid, volumeDefines);
+    if (!p) p = std::make_unique<gpu::CompactPass>(library, pyramid.defines(), volumeDefines);
     return *p;
+  }
+  GpuSimulatorOptions::Timing timingMode() const {
+    if (config.timing != GpuSimulatorOptions::Timing::Auto) return config.timing;
+    const std::string& r = gl::GlContext::current()->info().renderer;
+    const bool software = r.find("llvmpipe") != std::string::npos || r.find("softpipe") != std::string::npos ||
+                          r.find("swrast") != std::string::npos;
+    return software ? GpuSimulatorOptions::Timing::Off : GpuSimulatorOptions::Timing::Queries;
+  }
+  Ledger& ledgerFor() {
+    if (!ledger) ledger = std::make_unique<Ledger>(library, config.ledger_interval);
+    return *ledger;
   }
 
   BakeResult run(const LightSpec& light, const SimulationOptions& options);
@@ -485,7 +546,11 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
                        std::to_string(maxSide) + " (raise patch_voxels, or GpuSimulatorOptions::max_patch_side)");
   }
   std::vector<PatchTexels> packed(initial.size());
-  for (std::size_t i = 0; i < initial.size(); ++i) packed[i] = packPatch(initial[i]);
+  for (std::size_t i = 0; i < initial.size(); ++i) {
+    Patch local = initial[i];
+    for (glm::dvec3& x : local.x) x -= origin;
+    packed[i] = packPatch(local);
+  }
 
   const int firstSide = std::min(maxSide, patchSideFor(initial.size(), 64));
   std::unique_ptr<ListSet> lists = std::make_unique<ListSet>(firstSide, library);
@@ -494,16 +559,16 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
 
   AtlasTargets atlas(atlasLayout, options.deposit);
   info.atlas_bytes = atlas.bytes();
-  Ledger ledger(library, volumeDefines, this->options.ledger_interval);
+  Ledger& ledger = ledgerFor();
+  ledger.reset();
 
   const double dt = timeStep(grid, options);
-  const double h = voxelEdge(grid);
-  StepUniforms step;
+  gpu::StepUniforms step;
   step.dt = static_cast<float>(dt);
   step.boundaryOn = static_cast<float>(options.boundary_on);
   step.boundaryOff = static_cast<float>(options.boundary_off);
   step.fluxKill = static_cast<float>(options.flux_threshold * fluxRef);
-  step.splitLength = static_cast<float>(options.split_voxels * h);
+  step.splitLength = static_cast<float>(splitThreshold(grid, options));  // split_voxels·h·(1 + margin)
   step.maxDepth = static_cast<float>(options.max_depth);
   // E_ref of the max-mode depth mapping: a small irradiance, so that bright patches get depths near
   // 0 where Depth32F is most precise (largest initial E / 1000).
@@ -511,16 +576,16 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   for (const Patch& p : initial) eRef = std::max(eRef, luminance(p.irradiance()));
   const float energyRef = static_cast<float>(std::max(eRef * 1e-3, 1e-30));
 
-  UpdatePass& updatePass = update(options.integrator);
-  DepositPass& depositPass = deposit(options.deposit);
-  AnalysisPass& analysisPass = analyse(options.deposit);
+  const gpu::UpdatePass& updatePass = update(options.integrator);
+  const DepositPass& depositPass = deposit(options.deposit);
+  const gpu::AnalysisPass& analysisPass = analyse(options.deposit);
   stats.phase_seconds["init"] = secondsSince(t0);
 
   const int maxSteps = eik::maxSteps(grid, options);
   const double totalIn = luminance(stats.flux_in);
   std::size_t count = initial.size();
   stats.peak_patches = count;
-  PhaseTimer timer(this->options.timing, stats.phase_seconds);
+  PhaseTimer timer(timingMode(), stats.phase_seconds);
   auto report = [&] {
     ledger.flush();
     timer.collect(false);
@@ -538,18 +603,18 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     ListSet& L = *lists;
 
     timer.start("update");
-    updatePass.run(L.a, L.b, count, volume, gridUniforms, step, triangle);
-    timer.start("deposit");
-    depositPass.run(L.b, L.a, count, atlas, volume, gridUniforms, step.dt, energyRef);
+    updatePass.run(L.a, L.b, count, volume, gridUniforms, step);
     timer.start("analysis");
-    analysisPass.run(L.b, count, L.analysis, volume, gridUniforms, step, triangle);
+    analysisPass.run(L.b, L.a, count, L.targets, volume, gridUniforms, step);
+    timer.start("deposit");
+    depositPass.run(L.targets.depositA, L.targets.depositB, count, atlas, energyRef);
     timer.start("ledger");
-    ledger.addStep(L.a, L.b, L.fate, count, volume, gridUniforms, step.dt);
+    ledger.addStep(L.targets, L.b, count);
     timer.start("pyramid");
-    L.pyramid.build(count);
+    L.targets.pyramid.build(count);
     timer.stop();
     const auto readStart = Clock::now();
-    const std::uint64_t total = L.pyramid.readTotal();
+    const std::uint64_t total = L.targets.pyramid.readTotal();
     stats.phase_seconds["readback"] += secondsSince(readStart);
 
     if (total > L.a.capacity()) {
@@ -562,16 +627,27 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
                            " (GpuSimulatorOptions::max_patch_side, GL_MAX_TEXTURE_SIZE); raise split_voxels or "
                            "lower max_depth");
       }
+      const int side = std::min(maxSide, patchSideFor(total, L.side() * 2));
+      const std::size_t budget = config.budget_bytes ? config.budget_bytes : gl::defaultTextureBudget();
+      const std::size_t needed = info.volume_bytes + info.atlas_bytes + ListSet::bytesFor(L.side()) +
+                                 ListSet::bytesFor(side);  // the old set lives until the compaction
+      if (needed > budget) {
+        throw RuntimeError("GPU light simulator: step " + std::to_string(s + 1) + " needs " + std::to_string(total) +
+                           " patches, a patch list of " + std::to_string(side) + "x" + std::to_string(side) +
+                           " that takes the texture memory to " + bytesText(needed) + ", over the budget of " +
+                           bytesText(budget) + " (EIKONAL_GL_TEXTURE_BUDGET_MB); raise split_voxels or lower "
+                           "max_depth");
+      }
       timer.start("grow");
-      auto grown = std::make_unique<ListSet>(std::min(maxSide, patchSideFor(total, L.side() * 2)), library);
+      auto grown = std::make_unique<ListSet>(side, library);
       timer.start("compact");
-      compact(L.pyramid).run(L.b, L.pyramid, L.fate, grown->a, total, volume, gridUniforms, triangle);
+      compact(L.targets.pyramid).run(L.b, L.targets, grown->a, total, volume, gridUniforms);
       timer.stop();
       lists = std::move(grown);
       info.peak_patch_side = std::max(info.peak_patch_side, lists->side());
     } else if (total > 0) {
       timer.start("compact");
-      compact(L.pyramid).run(L.b, L.pyramid, L.fate, L.a, total, volume, gridUniforms, triangle);
+      compact(L.targets.pyramid).run(L.b, L.targets, L.a, total, volume, gridUniforms);
       timer.stop();
     }
     count = static_cast<std::size_t>(total);

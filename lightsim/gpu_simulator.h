@@ -2,18 +2,24 @@
 // of patches in textures, stepped with fragment-shader passes on OpenGL 3.3 (no compute shaders, no
 // transform feedback). One step:
 //
-//   pass        draws                               reads                 writes
-//   update      full-screen over the live box       list A, volume        list B (8 MRT)     steps 1–3
-//   deposit     GL_POINTS, one per patch            list B (+ A: Δs_m)    atlas (blend/depth) step 4
-//   analysis    full-screen                         list B                count, fate        step 5
-//   ledger      GL_POINTS, 3 per patch              lists A, B, fate      ledger row (blend)
-//   pyramid     histogram pyramid (HistoPyramid)    count                 pyramid; the total is read back
-//   compact     full-screen over the new box        list B, pyramid       list A (8 MRT)     step 6
+//   pass        draws                           reads                    writes
+//   update      full-screen over the live box   list A, volume           list B (8 MRT)       steps 1–3
+//   analysis    full-screen over the live box   list B (+ A: m_old, Φ),  count (pyramid base),  step 5,
+//                                               volume                   deposit A/B, ledger A/B and the
+//                                                                        per-patch work of 2–4
+//   deposit     GL_POINTS, one per patch        deposit A/B              atlas (blend / depth)  step 4
+//   ledger      GL_POINTS, one per patch        ledger A/B, list B       ledger row (blend, MRT)
+//   pyramid     HistoPyramid::build             count                    pyramid; the total is read back
+//   compact     full-screen over the new box    list B, pyramid, fate    list A (8 MRT)         step 6
 //
-// The list grows by reallocating both lists at the next power of two (nothing to copy: compaction
-// writes every live patch of the new list); its side is limited to max_patch_side (default 2048,
-// 4 Mi patches, 512 MiB a list) and to GL_MAX_TEXTURE_SIZE; a run that would exceed it stops with
-// a RuntimeError naming the step, the size and the limit.
+// All per-patch arithmetic happens in the fragment passes; the point passes only fetch a few texels
+// and scatter them (on llvmpipe vertex shading runs on one thread, fragments on all of them).
+// The list grows by reallocating both lists (and the analysis targets) at the next power of two
+// (nothing to copy: compaction writes every live patch of the new list). Memory: about 330 B a
+// patch slot (2 lists × 8 RGBA32F, 4 RGBA32F analysis targets, the pyramid). The side is limited
+// to max_patch_side (default 2048: 4 Mi patches, 1.3 GiB), GL_MAX_TEXTURE_SIZE and the texture
+// budget; a run that would exceed them stops with a RuntimeError naming the step, the size and the
+// limit.
 //
 // The only readback per step is the pyramid's total (one texel). The energy ledger (flux absorbed,
 // reflected, exited, killed per reason, counts, splits) is summed on the GPU into one row per step
@@ -31,23 +37,39 @@
 
 #include "core/volume.h"
 #include "gl/context.h"
+#include "gl/framebuffer.h"
+#include "gl/program.h"
+#include "gl/shader_library.h"
+#include "gl/texture.h"
+#include "gl/vertex_array.h"
+#include "gl/volume_textures.h"
+#include "lightsim/atlas.h"
+#include "lightsim/histo_pyramid.h"
+#include "lightsim/patch_textures.h"
 #include "lightsim/simulator.h"
 
 namespace eik {
 
 struct GpuSimulatorOptions {
   std::string source = "volume";  // the manifest, for error messages
-  // The patch list is at most max_patch_side² patches (a power of two; clamped to
-  // GL_MAX_TEXTURE_SIZE). Two lists of 8 RGBA32F textures: 256 B a patch, 1 GiB at 2048.
+  // The patch list is at most max_patch_side² patches (rounded down to a power of two; clamped to
+  // GL_MAX_TEXTURE_SIZE and 4096, the histogram pyramid's limit). About 330 B a slot: 1.3 GiB at 2048.
   int max_patch_side = 2048;
   int ledger_interval = 32;       // steps between ledger readbacks (and progress reports)
   // Phase times in SimulationStats::phase_seconds:
   //   Queries  GL_TIME_ELAPSED queries, collected asynchronously (does not serialise a GPU run);
-  //   Finish   glFinish after each phase and wall-clock time (exact on llvmpipe, slows a GPU);
-  //   Off      none but "init", "finish" and "total".
-  enum class Timing { Off, Queries, Finish };
-  Timing timing = Timing::Queries;
-  // Texture memory the bake may take (volume, atlas, patch lists); 0 = gl::defaultTextureBudget().
+  //   Finish   glFinish after each phase and wall-clock time (slows a GPU run);
+  //   Off      only "init", "readback", "output" and "total" (wall clock);
+  //   Auto     Queries on a hardware GPU, Off on a software rasteriser (llvmpipe, softpipe, swrast),
+  //            where queries cut the work into small flushes (measured: 15–40 % slower bakes).
+  enum class Timing { Auto, Off, Queries, Finish };
+  Timing timing = Timing::Auto;
+  // Sample n, ∇n and σa with trilinear interpolation done in the shader (8 texelFetch a lookup,
+  // float weights) instead of the texture units' filtering, whose weights GPUs quantise (8 bits of
+  // sub-texel position on NVIDIA). Agrees with the CPU twin to float rounding; slower on GPUs.
+  bool exact_sampling = false;
+  // Texture memory the bake may take (volume, atlas, patch lists, checked at construction and when
+  // the list grows); 0 = gl::defaultTextureBudget() (EIKONAL_GL_TEXTURE_BUDGET_MB, else 4 GiB).
   std::size_t budget_bytes = 0;
   // Use this GL back end when no context is current at construction (the simulator then owns one).
   gl::GlBackend backend = gl::GlBackend::Auto;
@@ -89,4 +111,70 @@ class GpuSimulator : public Simulator {
   std::unique_ptr<Impl> impl_;
 };
 
+// ---------------------------------------------------------------------------------------------
+// The passes of one step, exposed for tests (single steps on hand-made patches) and for anyone who
+// drives the simulation differently. Each takes its inputs and outputs explicitly.
+namespace gpu {
+
+// Constants of a run, as uniforms.
+struct StepUniforms {
+  float dt = 0.0f;                                   // Δt
+  float boundaryOn = 0.0f, boundaryOff = 0.0f;       // g_on, g_off
+  float fluxKill = 0.0f;                             // flux_threshold · Φ_ref
+  float splitLength = 0.0f;                          // split_voxels · h
+  float maxDepth = 0.0f;                             // max_depth
+};
+
+// What the analysis pass writes per patch (the patch list layout, mortonTexel(k)): the pyramid
+// (whose base takes the counts), deposit A/B and ledger A/B (shaders/lightsim/analysis.frag).
+struct StepTargets {
+  HistoPyramid pyramid;
+  gl::Texture2D depositA, depositB, ledgerA, ledgerB;  // RGBA32F
+  gl::Framebuffer framebuffer;                         // base, deposit A, B, ledger A, B
+
+  StepTargets(int side, const gl::ShaderLibrary& library);
+  static std::size_t bytesFor(int side);
+};
+
+// Steps 1–3: list `in` → list `out` (INTEGRATOR_EULER / _RK2 / _RK4 variants).
+class UpdatePass {
+ public:
+  UpdatePass(const gl::ShaderLibrary& library, Integrator integrator, const std::string& volumeDefines);
+  void run(const PatchTextures& in, PatchTextures& out, std::size_t count, const gl::VolumeTextures& volume,
+           const GridUniforms& grid, const StepUniforms& step) const;
+
+ private:
+  gl::Program program_;
+  gl::FullscreenTriangle triangle_;
+};
+
+// Step 5 and the per-patch work of steps 2–4 (deposit values, ledger entries): `current` is the
+// list after the update, `previous` the one before it.
+class AnalysisPass {
+ public:
+  AnalysisPass(const gl::ShaderLibrary& library, DepositMode mode, const AtlasLayout& atlas,
+               const std::string& volumeDefines);
+  void run(const PatchTextures& current, const PatchTextures& previous, std::size_t count, StepTargets& targets,
+           const gl::VolumeTextures& volume, const GridUniforms& grid, const StepUniforms& step) const;
+
+ private:
+  gl::Program program_;
+  gl::FullscreenTriangle triangle_;
+};
+
+// Step 6: list `in` (+ the pyramid and fates of its analysis) → list `out` of `total` patches.
+class CompactPass {
+ public:
+  // pyramidDefines: HistoPyramid::defines() of the pyramids it will read (their levels).
+  CompactPass(const gl::ShaderLibrary& library, const gl::ShaderDefines& pyramidDefines,
+              const std::string& volumeDefines);
+  void run(const PatchTextures& in, const StepTargets& targets, PatchTextures& out, std::size_t total,
+           const gl::VolumeTextures& volume, const GridUniforms& grid) const;
+
+ private:
+  gl::Program program_;
+  gl::FullscreenTriangle triangle_;
+};
+
+}  // namespace gpu
 }  // namespace eik

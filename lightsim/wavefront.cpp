@@ -21,15 +21,20 @@ struct AxisTap {
   double f;
 };
 
-inline AxisTap axisTap(double world, double lo, double extent, int n) {
-  // uvw = (x − min)/extent, c = uvw·dims − 0.5 (ALGORITHM.md "Units and inputs").
-  double c = (world - lo) / extent * static_cast<double>(n) - 0.5;
+// From the continuous voxel coordinate c: clamp-to-edge, i₀ = floor(c), i₁ = min(i₀ + 1, n − 1).
+inline AxisTap clampedTap(double c, int n) {
   const double top = static_cast<double>(n - 1);
   c = c > 0.0 ? (c < top ? c : top) : 0.0;  // NaN → 0
   int i0 = static_cast<int>(std::floor(c));
   if (i0 > n - 1) i0 = n - 1;
   const int i1 = i0 + 1 < n ? i0 + 1 : n - 1;
   return {i0, i1, c - static_cast<double>(i0)};
+}
+
+inline AxisTap axisTap(double world, double lo, double extent, int n) {
+  // uvw = (x − min)/extent, c = uvw·dims − 0.5 (ALGORITHM.md "Units and inputs").
+  double c = (world - lo) / extent * static_cast<double>(n) - 0.5;
+  return clampedTap(c, n);
 }
 
 struct Taps3 {
@@ -150,15 +155,18 @@ glm::dvec3 bilinear(const std::array<glm::dvec3, 4>& c, double u, double v) {
   return ((1.0 - u) * (1.0 - v)) * c[0] + (u * (1.0 - v)) * c[1] + (u * v) * c[2] + ((1.0 - u) * v) * c[3];
 }
 
-std::array<Patch, 4> splitPatch(const Patch& parent, const VolumeSampler& sampler) {
+std::array<Patch, 4> splitPatch(const Patch& parent, const VolumeSampler& sampler,
+                                std::array<std::array<glm::dvec4, 4>, 4>* corner_samples) {
   // The 3×3 corner grid at (u, v) ∈ {0, ½, 1}² (ALGORITHM.md step 6), computed once so that
   // children sharing a corner get identical bits.
   glm::dvec3 gx[3][3], gw[3][3];
+  glm::dvec4 gs[3][3];
   for (int iv = 0; iv < 3; ++iv) {
     for (int iu = 0; iu < 3; ++iu) {
       const double u = 0.5 * iu, v = 0.5 * iv;
       gx[iu][iv] = bilinear(parent.x, u, v);
-      gw[iu][iv] = renormalised(bilinear(parent.w, u, v), sampler.ior(gx[iu][iv]));
+      gs[iu][iv] = sampler.iorAndGradient(gx[iu][iv]);
+      gw[iu][iv] = renormalised(bilinear(parent.w, u, v), gs[iu][iv].x);
     }
   }
   std::array<Patch, 4> children;
@@ -172,6 +180,7 @@ std::array<Patch, 4> splitPatch(const Patch& parent, const VolumeSampler& sample
     for (int c = 0; c < 4; ++c) {
       child.x[c] = gx[cu[c]][cv[c]];
       child.w[c] = gw[cu[c]][cv[c]];
+      if (corner_samples) (*corner_samples)[j][c] = gs[cu[c]][cv[c]];
     }
     child.depth = parent.depth + 1;
     child.n_in = parent.n_in;

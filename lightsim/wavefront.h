@@ -126,7 +126,10 @@ constexpr std::array<std::array<double, 2>, 4> kSplitChildOrigin{{{0.0, 0.0}, {0
 // The 2×2 split of ALGORITHM.md step 6: corners and w from the bilinear patch at (u, v) ∈ {0,½,1}²,
 // w renormalised to n at the new corner, Φ_child = Φ·A_child/Σ A_children (flux conserved),
 // depth + 1, A₀ = A_child, n_in/cos_in/t_fresnel inherited.
-std::array<Patch, 4> splitPatch(const Patch& parent, const VolumeSampler& sampler);
+// `corner_samples` (optional): receives iorAndGradient at each child's corners (child j, corner c),
+// which the split samples anyway (the CPU twin reuses them in the next update).
+std::array<Patch, 4> splitPatch(const Patch& parent, const VolumeSampler& sampler,
+                                std::array<std::array<glm::dvec4, 4>, 4>* corner_samples = nullptr);
 
 // w scaled to length n (the renormalisation after each update and split); w unchanged if 0.
 inline glm::dvec3 renormalised(const glm::dvec3& w, double n) {
@@ -207,6 +210,15 @@ void validateOptions(const SimulationOptions& options);
 double timeStep(const GridSpec& grid, const SimulationOptions& options);
 // options.max_steps, or when 0: ceil(4 × grid diagonal / Δt).
 int maxSteps(const GridSpec& grid, const SimulationOptions& options);
+// The split threshold of step 5: a patch splits when its longest edge exceeds
+// split_voxels·h·(1 + kSplitMargin). Initial patches are made with edges of exactly
+// patch_voxels·h (= split_voxels·h by default), and without the margin rounding (double on the
+// CPU, float on the GPU) splits an arbitrary subset of them at once; 10⁻⁴ is far above float
+// rounding of an edge (≈ 10⁻⁷·extent/h relative) and far below anything physical.
+constexpr double kSplitMargin = 1e-4;
+inline double splitThreshold(const GridSpec& grid, const SimulationOptions& options) {
+  return options.split_voxels * voxelEdge(grid) * (1.0 + kSplitMargin);
+}
 // The flux kill threshold of step 5: flux_threshold · Φ_ref / 4^depth.
 inline double fluxKillThreshold(double flux_ref, const SimulationOptions& options, int depth) {
   return options.flux_threshold * flux_ref * std::ldexp(1.0, -2 * depth);

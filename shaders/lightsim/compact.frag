@@ -11,12 +11,12 @@
 #include "common/volume.glsl"
 #include "lightsim/grid.glsl"
 #include "lightsim/patch.glsl"
-#include "lightsim/fate.glsl"
+#include "lightsim/fate_codes.glsl"
 #include "lightsim/histo_pyramid.glsl"
 
 uniform sampler2D uPatch[8];   // the updated list (source)
 uniform sampler2D uPyramid;    // histogram pyramid over its counts
-uniform sampler2D uFate;       // fate codes of the analysis (FATE_SPLIT: count 4)
+uniform sampler2D uLedgerA;    // the analysis' (absorbed, fate): FATE_SPLIT means count 4
 uniform int uTotal;            // new list size
 
 layout(location = 0) out vec4 oP0;
@@ -41,7 +41,7 @@ void main() {
   ivec2 source = hpFind(uPyramid, k, j);
   Patch p;
   FETCH_PATCH(uPatch, source, p);
-  int fate = int(texelFetch(uFate, source, 0).r + 0.5);
+  int fate = int(texelFetch(uLedgerA, source, 0).w + 0.5);
 
   if (fate == FATE_SPLIT) {
     // The 3×3 grid of the split at (u, v) = (a/2, b/2); g[a + 3b].

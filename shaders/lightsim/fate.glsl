@@ -1,12 +1,6 @@
 // ALGORITHM.md step 5, analysis (thesis §6.2.4): what becomes of a patch after its update.
-// Codes (also the ledger's rows, lightsim/gpu_simulator.cpp):
-const int FATE_NONE = 0;     // no patch at this slot
-const int FATE_KEEP = 1;     // count 1
-const int FATE_SPLIT = 2;    // count 4
-const int FATE_EXITED = 3;   // count 0: outside the box, heading away
-const int FATE_FLUX = 4;     // count 0: max(Φ) under the threshold
-const int FATE_FOLDED = 5;   // count 0: N·d ≤ 0 (caustic singularity)
-const int FATE_DEPTH = 6;    // count 0: needs a split beyond max_depth
+// Needs lightsim/grid.glsl and lightsim/patch.glsl.
+#include "lightsim/fate_codes.glsl"
 
 uniform float uFluxKill;     // flux_threshold · Φ_ref
 uniform float uSplitLength;  // split_voxels · h
@@ -30,5 +24,3 @@ int patchFate(Patch p) {
   if (longest > uSplitLength) return p.depth >= uMaxDepth ? FATE_DEPTH : FATE_SPLIT;
   return FATE_KEEP;
 }
-
-float fateCount(int fate) { return fate == FATE_KEEP ? 1.0 : (fate == FATE_SPLIT ? 4.0 : 0.0); }

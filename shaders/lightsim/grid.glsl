@@ -8,9 +8,45 @@ uniform float uVoxelEdge;    // h, the smallest voxel edge
 uniform float uVoxelVolume;  // V_voxel
 
 vec3 gridUvw(vec3 x) { return (x - uBoundsMin) * uInvExtent; }
+
+#ifdef EXACT_TRILINEAR
+// GL_LINEAR + GL_CLAMP_TO_EDGE filtering done by hand with texelFetch and float weights, in the
+// order of the CPU twin's sampler (wavefront.cpp interpolate): hardware filtering quantises the
+// weights (to 1/256 on NVIDIA GPUs), this agrees with the CPU to float rounding. 8 fetches a lookup.
+uniform ivec3 uDims;
+vec4 exactTrilinear(sampler3D s, vec3 uvw) {
+  vec3 top = vec3(uDims - 1);
+  vec3 c = clamp(uvw * vec3(uDims) - 0.5, vec3(0.0), top);
+  ivec3 i0 = min(ivec3(floor(c)), uDims - 1);
+  ivec3 i1 = min(i0 + 1, uDims - 1);
+  vec3 f = c - vec3(i0), g = 1.0 - f;
+  vec4 c00 = texelFetch(s, ivec3(i0.x, i0.y, i0.z), 0) * g.x + texelFetch(s, ivec3(i1.x, i0.y, i0.z), 0) * f.x;
+  vec4 c10 = texelFetch(s, ivec3(i0.x, i1.y, i0.z), 0) * g.x + texelFetch(s, ivec3(i1.x, i1.y, i0.z), 0) * f.x;
+  vec4 c01 = texelFetch(s, ivec3(i0.x, i0.y, i1.z), 0) * g.x + texelFetch(s, ivec3(i1.x, i0.y, i1.z), 0) * f.x;
+  vec4 c11 = texelFetch(s, ivec3(i0.x, i1.y, i1.z), 0) * g.x + texelFetch(s, ivec3(i1.x, i1.y, i1.z), 0) * f.x;
+  return (c00 * g.y + c10 * f.y) * g.z + (c01 * g.y + c11 * f.y) * f.z;
+}
+#ifdef HAS_IOR
+float sampleIor(vec3 x) { return exactTrilinear(IOR_SAMPLER, gridUvw(x)).IOR_SWZ; }
+#else
+float sampleIor(vec3 x) { return 1.0; }
+#endif
+#ifdef HAS_IOR_GRAD
+vec3 sampleIorGrad(vec3 x) { return exactTrilinear(IOR_GRAD_SAMPLER, gridUvw(x)).IOR_GRAD_SWZ; }
+#else
+vec3 sampleIorGrad(vec3 x) { return vec3(0.0); }
+#endif
+#ifdef HAS_SIGMA_A
+vec3 sampleSigmaA(vec3 x) { return exactTrilinear(SIGMA_A_SAMPLER, gridUvw(x)).SIGMA_A_SWZ; }
+#else
+vec3 sampleSigmaA(vec3 x) { return vec3(0.0); }
+#endif
+#else
+// The texture units' own trilinear filtering (common/volume.glsl).
 float sampleIor(vec3 x) { return volumeIor(gridUvw(x)); }
 vec3 sampleIorGrad(vec3 x) { return volumeIorGrad(gridUvw(x)); }
 vec3 sampleSigmaA(vec3 x) { return volumeSigmaA(gridUvw(x)); }
+#endif
 
 // Inside the closed box [bounds_min, bounds_max] (wavefront.h insideBox).
 bool insideGrid(vec3 x) { return all(greaterThanEqual(x, uBoundsMin)) && all(lessThanEqual(x, uBoundsMax)); }

@@ -30,10 +30,9 @@ layout(location = 7) out vec4 oMeta;
 
 // Right-hand side of Eq. 4.12/4.13: dx/dt = w/n², dw/dt = ∇n/n.
 void rayRhs(vec3 x, vec3 w, out vec3 dx, out vec3 dw) {
-  vec3 uvw = gridUvw(x);
-  float n = volumeIor(uvw);
+  float n = sampleIor(x);
   dx = w / (n * n);
-  dw = volumeIorGrad(uvw) / n;
+  dw = sampleIorGrad(x) / n;
 }
 
 // Step 1 for one corner.
