@@ -12,8 +12,9 @@
 //  - Step 3, leaving a boundary layer: boundaryReflectance (wavefront.h): no reflection when the
 //    index on leaving is within boundary_off of the index on entering, and the Fresnel angle taken
 //    on the lower-index side. As written, the sphere above reflected 0.44 W instead of ≈ 0.13 W.
-//  - Step 5, split: longest edge > split_voxels·h·(1 + 10⁻⁴) (splitThreshold), so that rounding
-//    does not split initial patches whose edges are exactly one voxel.
+//  - Step 5, split: an edge > split_voxels·h·(1 + 10⁻⁴) (splitThreshold), so that rounding
+//    does not split initial patches whose edges are exactly one voxel; and by default only along
+//    the axes whose edges are too long (SplitRule::Axis, 1×2 splits: wavefront.h splitAxes).
 #include "lightsim/cpu_simulator.h"
 
 #include <array>
@@ -171,7 +172,7 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
     result.fate = PatchFate::Exited;
   } else if (options.deposit == DepositMode::Max && !(glm::dot(N, d_new) > 0.0)) {
     result.fate = PatchFate::Folded;  // orientation flipped: a caustic singularity
-  } else if (patch.longestEdge() > splitThreshold(grid, options)) {
+  } else if ((result.split = splitAxes(patch, splitThreshold(grid, options), options.split_rule)).any()) {
     result.fate = patch.depth >= options.max_depth ? PatchFate::KilledDepth : PatchFate::Split;
   } else {
     result.fate = PatchFate::Keep;
@@ -307,7 +308,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
       switch (r.fate) {
         case PatchFate::Keep: total += 1; break;
         case PatchFate::Split:
-          total += 4;
+          total += static_cast<std::size_t>(r.split.count());
           ++stats.splits;
           break;
         case PatchFate::KilledFlux:
@@ -346,10 +347,11 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
           if (n_out == 1) {
             next[out] = patches[i];
             next_samples[out] = samples[i];
-          } else if (n_out == 4) {
+          } else if (n_out > 1) {
             std::array<std::array<glm::dvec4, 4>, 4> corner_samples;
-            const std::array<Patch, 4> children = splitPatch(patches[i], sampler_, &corner_samples);
-            for (int j = 0; j < 4; ++j) {
+            std::array<Patch, 4> children;
+            const int count = splitPatch(patches[i], sampler_, results[i].split, children, &corner_samples);
+            for (int j = 0; j < count; ++j) {
               next[out + j] = children[j];
               next_samples[out + j].corner = corner_samples[j];
               next_samples[out + j].n_mid = sampler_.ior(children[j].midpoint());

@@ -53,6 +53,7 @@ enum class PatchFate { Keep, Split, KilledFlux, Exited, Folded, KilledDepth };
 
 struct PatchStepResult {
   PatchFate fate = PatchFate::Keep;
+  SplitAxes split;                 // the axes a Split halves
   long long voxel = -1;            // voxel the deposit goes to (−1: the midpoint is outside the grid)
   glm::dvec3 deposit{0.0};         // accumulate: Φ·Δs_m/V_voxel; max: E = Φ/A
   glm::dvec3 deposit_dir{0.0};     // accumulate: lum(Φ)·Δs_m·d; max: d

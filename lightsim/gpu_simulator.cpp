@@ -223,6 +223,7 @@ void AnalysisPass::run(const PatchTextures& current, const PatchTextures& previo
   program_.set("uFluxKill", step.fluxKill);
   program_.set("uSplitLength", step.splitLength);
   program_.set("uMaxDepth", step.maxDepth);
+  program_.set("uAxisSplit", step.axisSplit);
   triangle_.draw();
   gl::checkErrors("AnalysisPass");
 }
@@ -570,6 +571,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   step.fluxKill = static_cast<float>(options.flux_threshold * fluxRef);
   step.splitLength = static_cast<float>(splitThreshold(grid, options));  // split_voxels·h·(1 + margin)
   step.maxDepth = static_cast<float>(options.max_depth);
+  step.axisSplit = options.split_rule == SplitRule::Axis;
   // E_ref of the max-mode depth mapping: a small irradiance, so that bright patches get depths near
   // 0 where Depth32F is most precise (largest initial E / 1000).
   double eRef = 0.0;

@@ -123,6 +123,7 @@ struct StepUniforms {
   float fluxKill = 0.0f;                             // flux_threshold · Φ_ref
   float splitLength = 0.0f;                          // split_voxels · h
   float maxDepth = 0.0f;                             // max_depth
+  bool axisSplit = true;                             // SplitRule::Axis
 };
 
 // What the analysis pass writes per patch (the patch list layout, mortonTexel(k)): the pyramid

@@ -437,20 +437,24 @@ TEST(GpuSimulatorTest, MaxModeAndRk4MatchCpu) {
 }
 
 // One step of the CPU twin on a list (stepPatch, then compaction and expansion by prefix sum).
-std::vector<Patch> cpuStep(const std::vector<Patch>& patches, const StepContext& ctx, int* splits = nullptr) {
+// `splits` counts the splits by their number of children (index 2: 1×2, index 4: 2×2).
+std::vector<Patch> cpuStep(const std::vector<Patch>& patches, const StepContext& ctx,
+                           std::array<int, 5>* splits = nullptr) {
   std::vector<Patch> next;
   for (Patch p : patches) {
     const PatchStepResult r = stepPatch(p, ctx);
     if (r.fate == PatchFate::Keep) next.push_back(p);
     if (r.fate == PatchFate::Split) {
-      if (splits) ++*splits;
-      for (const Patch& child : splitPatch(p, *ctx.sampler)) next.push_back(child);
+      if (splits) ++(*splits)[static_cast<std::size_t>(r.split.count())];
+      std::array<Patch, 4> children;
+      const int count = splitPatch(p, *ctx.sampler, r.split, children);
+      next.insert(next.end(), children.begin(), children.begin() + count);
     }
   }
   return next;
 }
 
-TEST(GpuSimulatorTest, OneStepOfThePassesMatchesTheCpuTwinPatchForPatch) {
+void expectOneStepMatchesTheCpuTwin(SplitRule rule) {
   // A list taken mid-flight (patches in the boundary layer, inside the glass, splitting), one step
   // through the passes (update, analysis, pyramid, compaction), against the CPU twin's step: same
   // patches in the same order (the pyramid's Morton order is the prefix sum's index order), to
@@ -459,6 +463,7 @@ TEST(GpuSimulatorTest, OneStepOfThePassesMatchesTheCpuTwinPatchForPatch) {
   const Volume volume = glassSphere(24, ",sigma_a=0.5:1:2");
   VolumeSampler sampler(volume);
   SimulationOptions options = testOptions();
+  options.split_rule = rule;
   LightSpec light;
   light.direction = glm::normalize(glm::dvec3(0.3, -1.0, 0.2));
   double fluxRef = 0.0;
@@ -467,7 +472,7 @@ TEST(GpuSimulatorTest, OneStepOfThePassesMatchesTheCpuTwinPatchForPatch) {
   for (int i = 0; i < 45; ++i) patches = cpuStep(patches, ctx);
   // Round to float first, so both sides start from the same numbers.
   for (Patch& p : patches) p = unpackPatch(packPatch(p));
-  int splits = 0;
+  std::array<int, 5> splits{};
   const std::vector<Patch> want = cpuStep(patches, ctx, &splits);
 
   gl::ShaderLibrary library;
@@ -482,6 +487,7 @@ TEST(GpuSimulatorTest, OneStepOfThePassesMatchesTheCpuTwinPatchForPatch) {
   step.fluxKill = static_cast<float>(options.flux_threshold * fluxRef);
   step.splitLength = static_cast<float>(splitThreshold(volume.grid, options));
   step.maxDepth = static_cast<float>(options.max_depth);
+  step.axisSplit = options.split_rule == SplitRule::Axis;
   const int side = patchSideFor(std::max(patches.size(), want.size()));
   PatchTextures a(side), b(side);
   std::vector<PatchTexels> packed;
@@ -511,14 +517,24 @@ TEST(GpuSimulatorTest, OneStepOfThePassesMatchesTheCpuTwinPatchForPatch) {
     EXPECT_NEAR(g.area0, c.area0, 1e-5 * c.area0 + 1e-12) << k;
     inLayer += c.n_in != 0.0 ? 1 : 0;
   }
-  std::printf("%zu → %zu patches, %d splits, %d in a boundary layer; worst |Δx| %.2e voxel, "
-              "|Δw| %.2e, flux %.2e relative\n", patches.size(), want.size(), splits, inLayer, worstX, worstW,
-              worstFlux);
+  std::printf("%zu → %zu patches, %d 1×2 and %d 2×2 splits, %d in a boundary layer; worst |Δx| %.2e voxel, "
+              "|Δw| %.2e, flux %.2e relative\n", patches.size(), want.size(), splits[2], splits[4], inLayer, worstX,
+              worstW, worstFlux);
   EXPECT_GT(inLayer, 0);
-  EXPECT_GT(splits, 0);
+  // Axis: 1×2 splits (and 2×2 ones where both edges grew); Quad: 2×2 splits only.
+  EXPECT_GT(splits[rule == SplitRule::Axis ? 2 : 4], 0);
+  if (rule == SplitRule::Quad) EXPECT_EQ(splits[2], 0);
   EXPECT_LT(worstX, 1e-4);
   EXPECT_LT(worstW, 1e-4);
   EXPECT_LT(worstFlux, 1e-4);
+}
+
+TEST(GpuSimulatorTest, OneStepOfThePassesMatchesTheCpuTwinPatchForPatch) {
+  expectOneStepMatchesTheCpuTwin(SplitRule::Axis);
+}
+
+TEST(GpuSimulatorTest, OneStepWithTheThesisQuadSplitMatchesTheCpuTwin) {
+  expectOneStepMatchesTheCpuTwin(SplitRule::Quad);
 }
 
 class AbsorbingSlab : public testing::TestWithParam<glm::dvec3> {};

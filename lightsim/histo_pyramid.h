@@ -28,7 +28,7 @@
 // Limits
 //   * Counts are non-negative integers stored as floats. Sums are exact while every partial sum is
 //     ≤ 2^24 = 16 777 216, hence the traversal is exact for total ≤ kExactTotal. A single slot may
-//     hold any count up to that (lightsim uses 0, 1 and 4); fractional or negative counts are not
+//     hold any count up to that (lightsim uses 0, 1, 2 and 4); fractional or negative counts are not
 //     supported. readTotal() is exact up to 2^24 and never less than min(true total, 2^24).
 //   * Base side ≤ kMaxBaseSize = 4096 (2^24 slots; also ≤ GL_MAX_TEXTURE_SIZE, checked). The caller
 //     must check readTotal() against the output list's capacity (grow it, up to 4096², or refuse)

@@ -47,7 +47,8 @@ LightSpec lightFromScene(const fs::path& file) {
 
 int run(int argc, char** argv) {
   std::string input, output, light_text, power_text = "1,1,1", scene_path, backend = "gl", deposit = "accumulate",
-                                         integrator = "euler", stats_path, gl_backend = "auto";
+                                         integrator = "euler", split_rule = "axis", stats_path,
+                                         gl_backend = "auto";
   SimulationOptions options;
   bool quiet = false, raw = false;
   CLI::App app{
@@ -75,7 +76,11 @@ int run(int argc, char** argv) {
   app.add_option("--patch", options.patch_voxels, "initial patch edge in voxels (default 1)")->check(CLI::Range(0.05, 8.0));
   app.add_option("--split", options.split_voxels, "split patches with an edge longer than this, in voxels (default 1)")
       ->check(CLI::Range(0.1, 16.0));
-  app.add_option("--max-depth", options.max_depth, "splits allowed per initial patch (default 8)")->check(CLI::Range(0, 16));
+  app.add_option("--split-rule", split_rule,
+                 "axis (default: halve only the directions whose edges are too long, 1x2 or 2x2) or quad "
+                 "(the thesis: always 2x2)")
+      ->check(CLI::IsMember({"axis", "quad"}));
+  app.add_option("--max-depth", options.max_depth, "splits allowed per initial patch, a 1x2 split counting 1/2 (default 8)")->check(CLI::Range(0, 16));
   app.add_option("--max-steps", options.max_steps, "step limit (default: 4 grid diagonals)")->check(CLI::Range(0, 1000000));
   app.add_option("--flux-threshold", options.flux_threshold,
                  "kill patches below this fraction of the initial patch flux (default 1e-4)")
@@ -102,6 +107,7 @@ int run(int argc, char** argv) {
     throw InputError("command line", "--light", "give either --light (with --power) or --scene");
   const LightSpec light = scene_path.empty() ? parseLight(light_text, power_text) : lightFromScene(scene_path);
   options.deposit = deposit == "max" ? DepositMode::Max : DepositMode::Accumulate;
+  options.split_rule = split_rule == "quad" ? SplitRule::Quad : SplitRule::Axis;
   options.integrator = integrator == "rk4" ? Integrator::RK4 : integrator == "rk2" ? Integrator::RK2 : Integrator::Euler;
 
   Volume volume = readVolume(input);

@@ -73,7 +73,7 @@ Patch unpackPatch(const PatchTexels& t) {
   p.w[3] = glm::dvec3(t[3].w, t[5].z, t[5].w);
   p.flux = glm::dvec3(t[6]);
   p.area0 = t[6].w;
-  p.depth = static_cast<int>(std::lround(t[7].x));
+  p.depth = static_cast<double>(t[7].x);  // a multiple of ½, exact in float
   p.n_in = t[7].y;
   p.cos_in = t[7].z;
   p.t_fresnel = t[7].w;

@@ -30,6 +30,8 @@ struct LightSpec {
 
 enum class DepositMode { Accumulate, Max };
 enum class Integrator { Euler, RK2, RK4 };
+// How a patch with an edge over the split length is divided (ALGORITHM.md step 5, wavefront.h).
+enum class SplitRule { Quad, Axis };
 
 struct SimulationOptions {
   DepositMode deposit = DepositMode::Accumulate;
@@ -37,7 +39,8 @@ struct SimulationOptions {
   double step_voxels = 0.5;       // Δt = step_voxels·h: the arc length per step in air, in voxels
   double patch_voxels = 1.0;      // initial patch edge, at most this many voxels
   double split_voxels = 1.0;      // split a patch whose longest edge exceeds this many voxels
-  int max_depth = 8;              // splits allowed per initial patch
+  SplitRule split_rule = SplitRule::Axis;  // Axis: halve only the long direction (1×2); Quad: 2×2 (thesis)
+  int max_depth = 8;              // splits allowed per initial patch (a 1×2 split counts ½)
   double flux_threshold = 1e-4;   // kill below this fraction of the largest initial patch flux / 4^depth
   int max_steps = 0;              // 0: 4 × the grid diagonal in steps
   double boundary_on = 0.02;      // |∇n|·h entering a boundary layer (Fresnel tracking)

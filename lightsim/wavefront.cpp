@@ -155,25 +155,36 @@ glm::dvec3 bilinear(const std::array<glm::dvec3, 4>& c, double u, double v) {
   return ((1.0 - u) * (1.0 - v)) * c[0] + (u * (1.0 - v)) * c[1] + (u * v) * c[2] + ((1.0 - u) * v) * c[3];
 }
 
-std::array<Patch, 4> splitPatch(const Patch& parent, const VolumeSampler& sampler,
-                                std::array<std::array<glm::dvec4, 4>, 4>* corner_samples) {
-  // The 3×3 corner grid at (u, v) ∈ {0, ½, 1}² (ALGORITHM.md step 6), computed once so that
-  // children sharing a corner get identical bits.
+SplitAxes splitAxes(const Patch& p, double threshold, SplitRule rule) {
+  if (rule == SplitRule::Quad) {
+    const bool split = p.longestEdge() > threshold;
+    return {split, split};
+  }
+  const double u_edge = std::max(glm::length(p.x[1] - p.x[0]), glm::length(p.x[2] - p.x[3]));
+  const double v_edge = std::max(glm::length(p.x[2] - p.x[1]), glm::length(p.x[3] - p.x[0]));
+  return {u_edge > threshold, v_edge > threshold};
+}
+
+int splitPatch(const Patch& parent, const VolumeSampler& sampler, SplitAxes axes, std::array<Patch, 4>& children,
+               std::array<std::array<glm::dvec4, 4>, 4>* corner_samples) {
+  const int nu = axes.u ? 2 : 1, nv = axes.v ? 2 : 1;
+  const int count = nu * nv;
+  // The (nu + 1) × (nv + 1) corner grid at (u, v) = (iu/nu, iv/nv) (ALGORITHM.md step 6), computed
+  // once so that children sharing a corner get identical bits.
   glm::dvec3 gx[3][3], gw[3][3];
   glm::dvec4 gs[3][3];
-  for (int iv = 0; iv < 3; ++iv) {
-    for (int iu = 0; iu < 3; ++iu) {
-      const double u = 0.5 * iu, v = 0.5 * iv;
+  for (int iv = 0; iv <= nv; ++iv) {
+    for (int iu = 0; iu <= nu; ++iu) {
+      const double u = static_cast<double>(iu) / nu, v = static_cast<double>(iv) / nv;
       gx[iu][iv] = bilinear(parent.x, u, v);
       gs[iu][iv] = sampler.iorAndGradient(gx[iu][iv]);
       gw[iu][iv] = renormalised(bilinear(parent.w, u, v), gs[iu][iv].x);
     }
   }
-  std::array<Patch, 4> children;
   double total_area = 0.0;
   std::array<double, 4> areas{};
-  for (int j = 0; j < 4; ++j) {
-    const int u0 = static_cast<int>(2.0 * kSplitChildOrigin[j][0]), v0 = static_cast<int>(2.0 * kSplitChildOrigin[j][1]);
+  for (int j = 0; j < count; ++j) {
+    const int u0 = j % nu, v0 = j / nu;
     const int cu[4] = {u0, u0 + 1, u0 + 1, u0};
     const int cv[4] = {v0, v0, v0 + 1, v0 + 1};
     Patch& child = children[j];
@@ -182,7 +193,7 @@ std::array<Patch, 4> splitPatch(const Patch& parent, const VolumeSampler& sample
       child.w[c] = gw[cu[c]][cv[c]];
       if (corner_samples) (*corner_samples)[j][c] = gs[cu[c]][cv[c]];
     }
-    child.depth = parent.depth + 1;
+    child.depth = parent.depth + 0.25 * count;  // +1 for 2×2, +½ for 1×2
     child.n_in = parent.n_in;
     child.cos_in = parent.cos_in;
     child.t_fresnel = parent.t_fresnel;
@@ -191,8 +202,15 @@ std::array<Patch, 4> splitPatch(const Patch& parent, const VolumeSampler& sample
     total_area += areas[j];
   }
   // Φ_child = Φ·A_child / Σ A_children: flux conserved exactly (to rounding).
-  for (int j = 0; j < 4; ++j)
-    children[j].flux = total_area > 0.0 ? parent.flux * (areas[j] / total_area) : 0.25 * parent.flux;
+  for (int j = 0; j < count; ++j)
+    children[j].flux = total_area > 0.0 ? parent.flux * (areas[j] / total_area) : parent.flux / static_cast<double>(count);
+  return count;
+}
+
+std::array<Patch, 4> splitPatch(const Patch& parent, const VolumeSampler& sampler,
+                                std::array<std::array<glm::dvec4, 4>, 4>* corner_samples) {
+  std::array<Patch, 4> children;
+  splitPatch(parent, sampler, SplitAxes{true, true}, children, corner_samples);
   return children;
 }
 

@@ -39,7 +39,7 @@ struct Patch {
   std::array<glm::dvec3, 4> w{};  // corner directions, |w_c| = n(x_c) (Eq. 4.12/4.13)
   glm::dvec3 flux{0.0};           // Φ in W per channel; Φ = E·A (intensity law, Eq. 4.15/4.16)
   double area0 = 0.0;             // A₀, the area at creation (initialisation or split)
-  int depth = 0;                  // splits since initialisation
+  double depth = 0.0;             // splits since initialisation: +1 per 2×2 split, +½ per 1×2 split
   double n_in = 0.0;              // n before the boundary layer the patch is in; 0: not in a layer
   double cos_in = 0.0;            // |cos θ| of incidence on entering that layer
   double t_fresnel = 1.0;         // 1 − R applied in the last step (1 when none)
@@ -119,15 +119,36 @@ bool rayHitsBox(const glm::dvec3& origin, const glm::dvec3& dir, const glm::dvec
 // The bilinear patch through corners x₀ = (0,0), x₁ = (1,0), x₂ = (1,1), x₃ = (0,1) at (u, v).
 glm::dvec3 bilinear(const std::array<glm::dvec3, 4>& c, double u, double v);
 
-// Parameter origin (u_j, v_j) of child j of a split: (0,0), (½,0), (0,½), (½,½) (step 6; the
+// Parameter origin (u_j, v_j) of child j of a 2×2 split: (0,0), (½,0), (0,½), (½,½) (step 6; the
 // histogram pyramid's child order 0: (0,0), 1: (1,0), 2: (0,1), 3: (1,1)).
 constexpr std::array<std::array<double, 2>, 4> kSplitChildOrigin{{{0.0, 0.0}, {0.5, 0.0}, {0.0, 0.5}, {0.5, 0.5}}};
 
-// The 2×2 split of ALGORITHM.md step 6: corners and w from the bilinear patch at (u, v) ∈ {0,½,1}²,
-// w renormalised to n at the new corner, Φ_child = Φ·A_child/Σ A_children (flux conserved),
-// depth + 1, A₀ = A_child, n_in/cos_in/t_fresnel inherited.
+// Which parameter directions a split halves (ALGORITHM.md step 5). The u edges are x₀x₁ and x₃x₂,
+// the v edges x₁x₂ and x₀x₃.
+struct SplitAxes {
+  bool u = false;
+  bool v = false;
+  bool any() const { return u || v; }
+  int count() const { return (u ? 2 : 1) * (v ? 2 : 1); }  // children: 1 (no split), 2 or 4
+};
+
+// The split rule of step 5 for a patch and a threshold length:
+//  - SplitRule::Quad (the thesis): both axes when the longest of the four sides exceeds it;
+//  - SplitRule::Axis (default): each axis whose longer edge exceeds it, so a sliver stretched along
+//    one direction is halved along that one only (1×2) instead of into four slivers.
+SplitAxes splitAxes(const Patch& patch, double threshold, SplitRule rule);
+
+// The split of ALGORITHM.md step 6 into axes.count() children: corners and w from the bilinear
+// patch at (u, v) ∈ {0, 1/nu, 1} × {0, 1/nv, 1} (nu = 2 when axes.u, else 1; likewise nv), w
+// renormalised to n at the new corner, Φ_child = Φ·A_child/Σ A_children (flux conserved), depth + 1
+// for a 2×2 split and + ½ for a 1×2 one (so Φ ≈ Φ₀/4^depth either way), A₀ = A_child,
+// n_in/cos_in/t_fresnel inherited. Child j covers parameter cell (j mod nu, j div nu).
 // `corner_samples` (optional): receives iorAndGradient at each child's corners (child j, corner c),
 // which the split samples anyway (the CPU twin reuses them in the next update).
+// Returns the number of children written to `children`.
+int splitPatch(const Patch& parent, const VolumeSampler& sampler, SplitAxes axes, std::array<Patch, 4>& children,
+               std::array<std::array<glm::dvec4, 4>, 4>* corner_samples = nullptr);
+// The 2×2 split.
 std::array<Patch, 4> splitPatch(const Patch& parent, const VolumeSampler& sampler,
                                 std::array<std::array<glm::dvec4, 4>, 4>* corner_samples = nullptr);
 

@@ -205,6 +205,62 @@ TEST(Split, ConservesFluxAndTilesTheParent) {
   EXPECT_NEAR(a, q.area(), 1e-14);
 }
 
+TEST(Split, AxisRuleHalvesOnlyTheLongDirection) {
+  const Volume v = uniformVolume(cubicGrid(8, 1.0), 1.3);
+  const VolumeSampler s(v);
+  // A sliver: u edges (x0x1, x3x2) 0.3 long, v edges (x1x2, x0x3) 0.05.
+  Patch p;
+  p.x = {glm::dvec3(0, 0, 0), {0.3, 0.0, 0.01}, {0.31, 0.05, 0.0}, {0.0, 0.05, 0.0}};
+  for (auto& w : p.w) w = {0.0, 0.0, 1.3};
+  p.flux = {2.0, 1.0, 0.5};
+  p.depth = 1.5;
+  const double threshold = 0.2;
+  const SplitAxes axis = splitAxes(p, threshold, SplitRule::Axis);
+  EXPECT_TRUE(axis.u);
+  EXPECT_FALSE(axis.v);
+  EXPECT_EQ(axis.count(), 2);
+  const SplitAxes quad = splitAxes(p, threshold, SplitRule::Quad);
+  EXPECT_TRUE(quad.u && quad.v);
+  EXPECT_EQ(quad.count(), 4);
+  EXPECT_FALSE(splitAxes(p, 0.4, SplitRule::Axis).any());
+  EXPECT_FALSE(splitAxes(p, 0.4, SplitRule::Quad).any());
+  // The same sliver turned by 90° in parameter space splits along v.
+  Patch q = p;
+  q.x = {p.x[1], p.x[2], p.x[3], p.x[0]};
+  const SplitAxes turned = splitAxes(q, threshold, SplitRule::Axis);
+  EXPECT_FALSE(turned.u);
+  EXPECT_TRUE(turned.v);
+
+  for (const auto& [patch, axes] : {std::pair{p, axis}, std::pair{q, turned}}) {
+    std::array<Patch, 4> children;
+    ASSERT_EQ(splitPatch(patch, s, axes, children), 2);
+    const Patch &a = children[0], &b = children[1];
+    EXPECT_EQ(a.depth, 2.0);  // + ½ for a 1×2 split
+    EXPECT_EQ(b.depth, 2.0);
+    EXPECT_NEAR(glm::distance(a.flux + b.flux, patch.flux), 0.0, 1e-14);
+    EXPECT_NEAR(a.flux.x / b.flux.x, a.area() / b.area(), 1e-12);
+    // The children tile the parent: its corners, and the shared edge at the long edges' midpoints.
+    EXPECT_EQ(a.x[0], patch.x[0]);
+    if (axes.u) {
+      EXPECT_EQ(b.x[1], patch.x[1]);
+      EXPECT_EQ(b.x[2], patch.x[2]);
+      EXPECT_EQ(a.x[3], patch.x[3]);
+      EXPECT_EQ(a.x[1], b.x[0]);
+      EXPECT_EQ(a.x[2], b.x[3]);
+      EXPECT_NEAR(glm::distance(a.x[1], 0.5 * (patch.x[0] + patch.x[1])), 0.0, 1e-15);
+    } else {
+      EXPECT_EQ(a.x[1], patch.x[1]);
+      EXPECT_EQ(b.x[2], patch.x[2]);
+      EXPECT_EQ(b.x[3], patch.x[3]);
+      EXPECT_EQ(a.x[3], b.x[0]);
+      EXPECT_EQ(a.x[2], b.x[1]);
+      EXPECT_NEAR(glm::distance(a.x[3], 0.5 * (patch.x[0] + patch.x[3])), 0.0, 1e-15);
+    }
+    // Both children are now within the threshold along the axis that was split.
+    for (const Patch& c : {a, b}) EXPECT_FALSE(splitAxes(c, threshold, SplitRule::Axis).any());
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Fresnel (seeds/README.md)
 

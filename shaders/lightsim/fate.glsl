@@ -5,6 +5,7 @@
 uniform float uFluxKill;     // flux_threshold · Φ_ref
 uniform float uSplitLength;  // split_voxels · h
 uniform float uMaxDepth;     // max_depth
+uniform bool uAxisSplit;     // SplitRule::Axis: halve only the directions whose edges are too long
 
 int patchFate(Patch p) {
   vec3 m = patchMidpoint(p);
@@ -18,9 +19,17 @@ int patchFate(Patch p) {
   // not divide by the area, so a caustic singularity does no harm there.
   if (!(dot(patchAreaVector(p), d) > 0.0)) return FATE_FOLDED;
 #endif
-  // split when the longest of the four sides exceeds split_voxels · h
-  float longest = max(max(distance(p.x[0], p.x[1]), distance(p.x[1], p.x[2])),
-                      max(distance(p.x[2], p.x[3]), distance(p.x[3], p.x[0])));
-  if (longest > uSplitLength) return p.depth >= uMaxDepth ? FATE_DEPTH : FATE_SPLIT;
-  return FATE_KEEP;
+  // split (wavefront.h splitAxes): u edges x0x1, x3x2; v edges x1x2, x0x3
+  float uEdge = max(distance(p.x[0], p.x[1]), distance(p.x[3], p.x[2]));
+  float vEdge = max(distance(p.x[1], p.x[2]), distance(p.x[0], p.x[3]));
+  bool splitU, splitV;
+  if (uAxisSplit) {
+    splitU = uEdge > uSplitLength;
+    splitV = vEdge > uSplitLength;
+  } else {
+    splitU = splitV = max(uEdge, vEdge) > uSplitLength;  // Quad: the longest side decides
+  }
+  if (!(splitU || splitV)) return FATE_KEEP;
+  if (p.depth >= uMaxDepth) return FATE_DEPTH;
+  return splitU && splitV ? FATE_SPLIT : splitU ? FATE_SPLIT_U : FATE_SPLIT_V;
 }

@@ -1,11 +1,20 @@
 // Fate codes of a patch after ALGORITHM.md step 5 (analysis), shared by the analysis, ledger and
-// compaction passes.
-const int FATE_NONE = 0;     // no patch at this slot
-const int FATE_KEEP = 1;     // count 1
-const int FATE_SPLIT = 2;    // count 4
-const int FATE_EXITED = 3;   // count 0: outside the box, heading away
-const int FATE_FLUX = 4;     // count 0: max(Φ) under the threshold
-const int FATE_FOLDED = 5;   // count 0: N·d ≤ 0 (caustic singularity)
-const int FATE_DEPTH = 6;    // count 0: needs a split beyond max_depth
+// compaction passes. Codes ≥ FATE_SPLIT are what the ledger records; codes ≥ FATE_EXITED are dead.
+const int FATE_NONE = 0;      // no patch at this slot
+const int FATE_KEEP = 1;      // count 1
+const int FATE_SPLIT = 2;     // count 4: 2×2 split
+const int FATE_SPLIT_U = 3;   // count 2: 1×2 split halving u (edges x0x1, x3x2)
+const int FATE_SPLIT_V = 4;   // count 2: 1×2 split halving v (edges x1x2, x0x3)
+const int FATE_EXITED = 5;    // count 0: outside the box, heading away
+const int FATE_FLUX = 6;      // count 0: max(Φ) under the threshold
+const int FATE_FOLDED = 7;    // count 0: N·d ≤ 0 (caustic singularity)
+const int FATE_DEPTH = 8;     // count 0: needs a split beyond max_depth
 
-float fateCount(int fate) { return fate == FATE_KEEP ? 1.0 : (fate == FATE_SPLIT ? 4.0 : 0.0); }
+bool fateSplits(int fate) { return fate >= FATE_SPLIT && fate <= FATE_SPLIT_V; }
+float fateCount(int fate) {
+  return fate == FATE_KEEP ? 1.0 : fate == FATE_SPLIT ? 4.0 : fateSplits(fate) ? 2.0 : 0.0;
+}
+// Children along u and v of a split fate: (2,2), (2,1) or (1,2).
+ivec2 fateSplitCells(int fate) {
+  return ivec2(fate == FATE_SPLIT_V ? 1 : 2, fate == FATE_SPLIT_U ? 1 : 2);
+}

@@ -40,7 +40,7 @@ void main() {
   if (fate == FATE_FLUX) vEntry[3] = dead;
   if (fate == FATE_FOLDED) vEntry[4] = dead;
   if (fate == FATE_DEPTH) vEntry[5] = dead;
-  if (fate == FATE_SPLIT) vEntry[6] = vec4(0.0, 0.0, 0.0, 1.0);
+  if (fateSplits(fate)) vEntry[6] = vec4(0.0, 0.0, 0.0, 1.0);
   emit = fate >= FATE_SPLIT || b.w > 0.0 || any(greaterThan(a.rgb, vec3(0.0)));
 #endif
   vec2 ndc = (vec2(float(gl_VertexID % uBins), float(uRow)) + 0.5) / uLedgerSize * 2.0 - 1.0;
