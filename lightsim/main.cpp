@@ -5,10 +5,15 @@
 //
 // The work lives in the library (gpu_simulator.h, cpu_simulator.h, bake.h); this file reads the
 // command line, reports progress and writes the outputs.
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
 #include "core/cli.h"
@@ -50,6 +55,7 @@ int run(int argc, char** argv) {
                                          integrator = "euler", split_rule = "axis", stats_path,
                                          gl_backend = "auto";
   SimulationOptions options;
+  int bench_runs = 0;
   bool quiet = false, raw = false;
   CLI::App app{
       "lightsim: propagate a light's wavefront through a volume as a GPU particle system of adaptive\n"
@@ -87,6 +93,10 @@ int run(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1.0));
   app.add_option("--gl", gl_backend, "OpenGL back end for --backend gl: auto | osmesa | egl (default auto)");
   app.add_option("--stats", stats_path, "write steps, patches, splits, kills, flux ledger and phase times as JSON");
+  app.add_option("--bench", bench_runs,
+                 "bake N times and print the median wall time, patch-steps per second, peak patches and (gl) "
+                 "texture memory; --stats gets them too; the last bake is written")
+      ->check(CLI::Range(1, 1000));
   app.add_flag("--raw", raw, "write raw NRRD data instead of gzip");
   app.add_flag("-q,--quiet", quiet, "no progress bar");
   app.footer(
@@ -123,10 +133,45 @@ int run(int argc, char** argv) {
     gpu.backend = gl::parseGlBackend(gl_backend);
     simulator = std::make_unique<GpuSimulator>(volume, gpu);
   }
-  ProgressBar bar("lightsim", !quiet);
+  ProgressBar bar("lightsim", !quiet && bench_runs == 0);
   options.progress = bar.callback();
-  BakeResult result = simulator->run(light, options);
+  BakeResult result;
+  std::vector<double> seconds;
+  for (int run = 0; run < std::max(1, bench_runs); ++run) {
+    const auto t0 = std::chrono::steady_clock::now();
+    result = simulator->run(light, options);
+    seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    if (bench_runs > 0 && !quiet)
+      std::fprintf(stderr, "lightsim: bench run %d of %d: %.3f s\n", run + 1, bench_runs, seconds.back());
+  }
   bar.finish();
+  nlohmann::json stats_json = result.stats.toJson();
+  if (const auto* gpu = dynamic_cast<const GpuSimulator*>(simulator.get())) {
+    const GpuRunInfo& info = gpu->lastRunInfo();
+    stats_json["texture_bytes"] = {{"volume", info.volume_bytes},
+                                   {"atlas", info.atlas_bytes},
+                                   {"patch_lists_peak", info.patch_bytes_peak},
+                                   {"total_peak", info.texture_bytes_peak}};
+  }
+  if (bench_runs > 0) {
+    std::vector<double> sorted = seconds;
+    std::sort(sorted.begin(), sorted.end());
+    const double median = sorted.size() % 2 ? sorted[sorted.size() / 2]
+                                             : 0.5 * (sorted[sorted.size() / 2 - 1] + sorted[sorted.size() / 2]);
+    const double rate = static_cast<double>(result.stats.total_patches) / median;
+    stats_json["bench"] = {{"runs", bench_runs},        {"seconds", seconds},
+                           {"median_s", median},        {"patch_steps_per_s", rate},
+                           {"grid", {volume.grid.dims.x, volume.grid.dims.y, volume.grid.dims.z}}};
+    std::printf("lightsim bench: %dx%dx%d, %s: median %.3f s of %d runs (min %.3f, max %.3f); %llu patch-steps, "
+                "%.3g patch-steps/s; peak %llu patches",
+                volume.grid.dims.x, volume.grid.dims.y, volume.grid.dims.z, result.stats.renderer.c_str(), median,
+                bench_runs, sorted.front(), sorted.back(), static_cast<unsigned long long>(result.stats.total_patches),
+                rate, static_cast<unsigned long long>(result.stats.peak_patches));
+    if (stats_json.contains("texture_bytes"))
+      std::printf("; %.1f MiB of textures at the peak",
+                  static_cast<double>(stats_json["texture_bytes"]["total_peak"].get<std::size_t>()) / (1 << 20));
+    std::printf("\n");
+  }
   if (lightMissedVolume(result.stats))
     std::fprintf(stderr, "lightsim: warning: the light misses the volume; the bake is empty\n");
 
@@ -134,7 +179,7 @@ int run(int argc, char** argv) {
   VolumeWriteOptions write;
   write.gzip = !raw;
   writeVolume(volume, output, write);
-  if (!stats_path.empty()) writeFileAtomic(stats_path, result.stats.toJson().dump(2) + "\n");
+  if (!stats_path.empty()) writeFileAtomic(stats_path, stats_json.dump(2) + "\n");
   if (!quiet) {
     const SimulationStats& s = result.stats;
     std::fprintf(stderr, "lightsim: %d steps, %llu initial / %llu peak patches, %llu splits on %s\n", s.steps,

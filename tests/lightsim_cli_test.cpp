@@ -2,6 +2,10 @@
 // light and statistics in the manifest; bad input exits 2 with a clear message and no output.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <string>
+#include <vector>
+
 #include <nlohmann/json.hpp>
 
 #include "core/volume.h"
@@ -40,6 +44,36 @@ TEST(LightsimCli, BakesOnBothBackends) {
     nlohmann::json stats = nlohmann::json::parse(readFile(dir / "stats.json"));
     EXPECT_GT(stats["steps"].get<int>(), 0);
     EXPECT_EQ(stats["backend"], backend);
+  }
+}
+
+TEST(LightsimCli, BenchRepeatsTheBakeAndReportsItsFigures) {
+  TempDir dir;
+  makeSphere(dir);
+  for (const char* backend : {"cpu", "gl"}) {
+    ProgramResult r = runProgram(LIGHTSIM_EXE,
+                                 {"ball.vol.json", "-o", "b.vol.json", "--light", "directional:0,-1,0", "--backend",
+                                  backend, "--max-depth", "2", "--bench", "3", "--stats", "bench.json", "--quiet"},
+                                 dir.path());
+    ASSERT_EQ(r.exit_code, 0) << backend << ": " << r.output;
+    EXPECT_NE(r.output.find("lightsim bench:"), std::string::npos) << r.output;
+    nlohmann::json stats = nlohmann::json::parse(readFile(dir / "bench.json"));
+    const nlohmann::json& bench = stats.at("bench");
+    EXPECT_EQ(bench.at("runs"), 3);
+    ASSERT_EQ(bench.at("seconds").size(), 3u);
+    std::vector<double> seconds = bench.at("seconds").get<std::vector<double>>();
+    std::sort(seconds.begin(), seconds.end());
+    EXPECT_EQ(bench.at("median_s").get<double>(), seconds[1]);
+    EXPECT_NEAR(bench.at("patch_steps_per_s").get<double>(),
+                stats.at("total_patches").get<double>() / seconds[1], 1e-6 * bench.at("patch_steps_per_s").get<double>());
+    // Texture memory is reported for the GPU path only: at least the patch lists and the atlas.
+    if (std::string(backend) == "gl") {
+      EXPECT_GT(stats.at("texture_bytes").at("patch_lists_peak").get<double>(), 0.0);
+      EXPECT_GE(stats.at("texture_bytes").at("total_peak").get<double>(),
+                stats.at("texture_bytes").at("atlas").get<double>() + stats.at("texture_bytes").at("volume").get<double>());
+    } else {
+      EXPECT_FALSE(stats.contains("texture_bytes"));
+    }
   }
 }
 
