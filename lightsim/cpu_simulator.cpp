@@ -173,7 +173,9 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
   } else if (options.deposit == DepositMode::Max && !(glm::dot(N, d_new) > 0.0)) {
     result.fate = PatchFate::Folded;  // orientation flipped: a caustic singularity
   } else if ((result.split = splitAxes(patch, splitThreshold(grid, options), options.split_rule)).any()) {
-    result.fate = patch.depth >= options.max_depth ? PatchFate::KilledDepth : PatchFate::Split;
+    const bool keep = options.at_max_depth == DepthLimit::Keep &&
+                      patch.longestEdge() <= kMaxUnsplitEdge * splitThreshold(grid, options);
+    result.fate = patch.depth < options.max_depth ? PatchFate::Split : keep ? PatchFate::Keep : PatchFate::KilledDepth;
   } else {
     result.fate = PatchFate::Keep;
   }

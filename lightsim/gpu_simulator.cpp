@@ -224,6 +224,7 @@ void AnalysisPass::run(const PatchTextures& current, const PatchTextures& previo
   program_.set("uSplitLength", step.splitLength);
   program_.set("uMaxDepth", step.maxDepth);
   program_.set("uAxisSplit", step.axisSplit);
+  program_.set("uKillAtMaxDepth", step.killAtMaxDepth);
   triangle_.draw();
   gl::checkErrors("AnalysisPass");
 }
@@ -572,6 +573,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   step.splitLength = static_cast<float>(splitThreshold(grid, options));  // split_voxels·h·(1 + margin)
   step.maxDepth = static_cast<float>(options.max_depth);
   step.axisSplit = options.split_rule == SplitRule::Axis;
+  step.killAtMaxDepth = options.at_max_depth == DepthLimit::Kill;
   // E_ref of the max-mode depth mapping: a small irradiance, so that bright patches get depths near
   // 0 where Depth32F is most precise (largest initial E / 1000).
   double eRef = 0.0;

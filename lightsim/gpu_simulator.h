@@ -124,6 +124,7 @@ struct StepUniforms {
   float splitLength = 0.0f;                          // split_voxels · h
   float maxDepth = 0.0f;                             // max_depth
   bool axisSplit = true;                             // SplitRule::Axis
+  bool killAtMaxDepth = false;                       // DepthLimit::Kill
 };
 
 // What the analysis pass writes per patch (the patch list layout, mortonTexel(k)): the pyramid

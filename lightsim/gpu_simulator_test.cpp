@@ -337,9 +337,9 @@ void expectLedgersAgree(const SimulationStats& gpu, const SimulationStats& cpu, 
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(sum[c], s->flux_in[c], 1e-5 * s->flux_in[c]) << s->backend << " channel " << c;
   }
   EXPECT_EQ(gpu.initial_patches, cpu.initial_patches);
-  EXPECT_EQ(gpu.steps, cpu.steps);
-  // Patch counts follow split and kill decisions taken in float on one side and double on the
-  // other: they agree closely, not exactly.
+  // Patch counts, and the step at which the last patch leaves, follow split and kill decisions
+  // taken in float on one side and double on the other: they agree closely, not exactly.
+  EXPECT_LE(std::abs(gpu.steps - cpu.steps), std::max(2, cpu.steps / 50));
   EXPECT_LE(relDiff(static_cast<double>(gpu.total_patches), static_cast<double>(cpu.total_patches),
                     static_cast<double>(cpu.total_patches)), 0.01);
   EXPECT_LE(relDiff(static_cast<double>(gpu.splits), static_cast<double>(cpu.splits),
@@ -488,6 +488,7 @@ void expectOneStepMatchesTheCpuTwin(SplitRule rule) {
   step.splitLength = static_cast<float>(splitThreshold(volume.grid, options));
   step.maxDepth = static_cast<float>(options.max_depth);
   step.axisSplit = options.split_rule == SplitRule::Axis;
+  step.killAtMaxDepth = options.at_max_depth == DepthLimit::Kill;
   const int side = patchSideFor(std::max(patches.size(), want.size()));
   PatchTextures a(side), b(side);
   std::vector<PatchTexels> packed;

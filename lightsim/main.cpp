@@ -52,7 +52,7 @@ LightSpec lightFromScene(const fs::path& file) {
 
 int run(int argc, char** argv) {
   std::string input, output, light_text, power_text = "1,1,1", scene_path, backend = "gl", deposit = "accumulate",
-                                         integrator = "euler", split_rule = "axis", stats_path,
+                                         integrator = "euler", split_rule = "axis", at_max_depth = "keep", stats_path,
                                          gl_backend = "auto";
   SimulationOptions options;
   int bench_runs = 0;
@@ -86,7 +86,11 @@ int run(int argc, char** argv) {
                  "axis (default: halve only the directions whose edges are too long, 1x2 or 2x2) or quad "
                  "(the thesis: always 2x2)")
       ->check(CLI::IsMember({"axis", "quad"}));
-  app.add_option("--max-depth", options.max_depth, "splits allowed per initial patch, a 1x2 split counting 1/2 (default 8)")->check(CLI::Range(0, 16));
+  app.add_option("--max-depth", options.max_depth, "splits allowed per initial patch, a 1x2 split counting 1/2 (default 6)")->check(CLI::Range(0, 16));
+  app.add_option("--at-max-depth", at_max_depth,
+                 "keep (default: a patch that should split beyond --max-depth goes on unsplit while its edges stay "
+                 "within 4 split lengths, then dies) or kill (the thesis: it dies at once)")
+      ->check(CLI::IsMember({"keep", "kill"}));
   app.add_option("--max-steps", options.max_steps, "step limit (default: 4 grid diagonals)")->check(CLI::Range(0, 1000000));
   app.add_option("--flux-threshold", options.flux_threshold,
                  "kill patches below this fraction of the initial patch flux (default 1e-4)")
@@ -118,6 +122,7 @@ int run(int argc, char** argv) {
   const LightSpec light = scene_path.empty() ? parseLight(light_text, power_text) : lightFromScene(scene_path);
   options.deposit = deposit == "max" ? DepositMode::Max : DepositMode::Accumulate;
   options.split_rule = split_rule == "quad" ? SplitRule::Quad : SplitRule::Axis;
+  options.at_max_depth = at_max_depth == "kill" ? DepthLimit::Kill : DepthLimit::Keep;
   options.integrator = integrator == "rk4" ? Integrator::RK4 : integrator == "rk2" ? Integrator::RK2 : Integrator::Euler;
 
   Volume volume = readVolume(input);

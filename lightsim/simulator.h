@@ -32,6 +32,8 @@ enum class DepositMode { Accumulate, Max };
 enum class Integrator { Euler, RK2, RK4 };
 // How a patch with an edge over the split length is divided (ALGORITHM.md step 5, wavefront.h).
 enum class SplitRule { Quad, Axis };
+// What becomes of a patch that should split beyond max_depth (ALGORITHM.md step 5).
+enum class DepthLimit { Keep, Kill };
 
 struct SimulationOptions {
   DepositMode deposit = DepositMode::Accumulate;
@@ -40,7 +42,10 @@ struct SimulationOptions {
   double patch_voxels = 1.0;      // initial patch edge, at most this many voxels
   double split_voxels = 1.0;      // split a patch whose longest edge exceeds this many voxels
   SplitRule split_rule = SplitRule::Axis;  // Axis: halve only the long direction (1×2); Quad: 2×2 (thesis)
-  int max_depth = 8;              // splits allowed per initial patch (a 1×2 split counts ½)
+  int max_depth = 6;              // splits allowed per initial patch (a 1×2 split counts ½)
+  // At max_depth a patch that should split is kept unsplit (Keep, default: its flux goes on and is
+  // deposited at its midpoint) or killed (Kill, the thesis §6.2.4; its flux is lost).
+  DepthLimit at_max_depth = DepthLimit::Keep;
   double flux_threshold = 1e-4;   // kill below this fraction of the largest initial patch flux / 4^depth
   int max_steps = 0;              // 0: 4 × the grid diagonal in steps
   double boundary_on = 0.02;      // |∇n|·h entering a boundary layer (Fresnel tracking)
@@ -52,7 +57,7 @@ struct KillCounts {
   std::uint64_t flux = 0;     // energy under the threshold
   std::uint64_t exited = 0;   // left the volume, heading away
   std::uint64_t folded = 0;   // orientation flipped (caustic singularity)
-  std::uint64_t depth = 0;    // needed a split beyond max_depth
+  std::uint64_t depth = 0;    // needed a split beyond max_depth (DepthLimit::Kill only)
 };
 
 struct SimulationStats {

@@ -240,6 +240,10 @@ constexpr double kSplitMargin = 1e-4;
 inline double splitThreshold(const GridSpec& grid, const SimulationOptions& options) {
   return options.split_voxels * voxelEdge(grid) * (1.0 + kSplitMargin);
 }
+// DepthLimit::Keep keeps a patch at max_depth unsplit only while its longest edge is at most this
+// many split lengths; beyond it the patch is killed (its midpoint no longer says where its flux
+// is, so its deposit would land far from the light it carries).
+constexpr double kMaxUnsplitEdge = 4.0;
 // The flux kill threshold of step 5: flux_threshold · Φ_ref / 4^depth.
 inline double fluxKillThreshold(double flux_ref, const SimulationOptions& options, int depth) {
   return options.flux_threshold * flux_ref * std::ldexp(1.0, -2 * depth);

@@ -29,7 +29,8 @@ TEST(LightsimCli, BakesOnBothBackends) {
     const std::string out = std::string("baked_") + backend + ".vol.json";
     ProgramResult r = runProgram(LIGHTSIM_EXE,
                                  {"ball.vol.json", "-o", out, "--light", "directional:0,-1,0", "--power", "2,2,2",
-                                  "--backend", backend, "--max-depth", "3", "--stats", "stats.json", "--quiet"},
+                                  "--backend", backend, "--max-depth", "3", "--at-max-depth", "kill", "--stats", "stats.json",
+                                  "--quiet"},
                                  dir.path());
     ASSERT_EQ(r.exit_code, 0) << backend << ": " << r.output;
     Volume v = readVolume(dir / out);

@@ -5,6 +5,7 @@
 uniform float uFluxKill;     // flux_threshold · Φ_ref
 uniform float uSplitLength;  // split_voxels · h
 uniform float uMaxDepth;     // max_depth
+uniform bool uKillAtMaxDepth;  // DepthLimit::Kill (else a patch at max_depth is kept unsplit)
 uniform bool uAxisSplit;     // SplitRule::Axis: halve only the directions whose edges are too long
 
 int patchFate(Patch p) {
@@ -30,6 +31,8 @@ int patchFate(Patch p) {
     splitU = splitV = max(uEdge, vEdge) > uSplitLength;  // Quad: the longest side decides
   }
   if (!(splitU || splitV)) return FATE_KEEP;
-  if (p.depth >= uMaxDepth) return FATE_DEPTH;
+  // At max_depth: kept unsplit (DepthLimit::Keep) while the longest edge is at most
+  // kMaxUnsplitEdge (4) split lengths (wavefront.h), else killed.
+  if (p.depth >= uMaxDepth) return uKillAtMaxDepth || max(uEdge, vEdge) > 4.0 * uSplitLength ? FATE_DEPTH : FATE_KEEP;
   return splitU && splitV ? FATE_SPLIT : splitU ? FATE_SPLIT_U : FATE_SPLIT_V;
 }
