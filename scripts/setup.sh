@@ -9,6 +9,7 @@ packages=(
   libglfw3-dev libglm-dev libopenimageio-dev openimageio-tools libtinygltf-dev python3-glad
   nlohmann-json3-dev libcli11-dev zlib1g-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libimgui-dev
   xvfb xauth
 )
 

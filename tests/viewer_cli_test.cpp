@@ -24,7 +24,8 @@ TEST(ViewerCli, RendersBeerLambertThroughTheCentre) {
   TempDir dir;
   makeSphere(dir);
   // Looking straight through the centre along -z: the central ray is not bent and crosses 2r = 1
-  // of material, so it keeps exp(-σa·1) of the white environment (the first viewer has no Fresnel).
+  // of material at normal incidence: the front reflection R = 0.04 of the white environment plus
+  // (1 - R)²·exp(-σa·1) through both faces.
   ProgramResult r = runProgram(VIEWER_EXE,
                                {"ball.vol.json", "--render", "ball.exr", "--size", "65x65", "--camera",
                                 "0,0,4:0,0,0:30", "--env", "uniform:1,1,1", "--quiet"},
@@ -34,9 +35,10 @@ TEST(ViewerCli, RendersBeerLambertThroughTheCentre) {
   ASSERT_EQ(image.width, 65);
   ASSERT_EQ(image.height, 65);
   const float* centre = image.at(32, 32);
-  EXPECT_NEAR(centre[0], 1.0f, 0.01f);
-  EXPECT_NEAR(centre[1], std::exp(-0.5f), 0.02f);
-  EXPECT_NEAR(centre[2], std::exp(-1.0f), 0.02f);
+  const float R = 0.04f;
+  EXPECT_NEAR(centre[0], R + (1 - R) * (1 - R), 0.01f);
+  EXPECT_NEAR(centre[1], R + (1 - R) * (1 - R) * std::exp(-0.5f), 0.02f);
+  EXPECT_NEAR(centre[2], R + (1 - R) * (1 - R) * std::exp(-1.0f), 0.02f);
   const float* corner = image.at(0, 0);  // misses the sphere: the environment itself
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(corner[c], 1.0f, 1e-3f);
 
@@ -57,6 +59,16 @@ TEST(ViewerCli, BadInputExitsTwo) {
   writeFile(dir / "unknown_key.json", R"({"objects": [{"volume": "ball.vol.json"}], "camera": {"fov": 40}})");
   writeFile(dir / "wrong_type.json", R"({"objects": [{"volume": "ball.vol.json", "scale": "big"}]})");
   writeFile(dir / "no_volume.json", R"({"objects": [{"volume": "missing.vol.json"}]})");
+  writeFile(dir / "env_missing.json",
+            R"({"objects": [{"volume": "ball.vol.json"}], "environment": {"file": "nowhere.exr"}})");
+  writeFile(dir / "env_unknown.json",
+            R"({"objects": [{"volume": "ball.vol.json"}], "environment": {"procedural": "nebula"}})");
+  writeFile(dir / "ground_type.json",
+            R"({"objects": [{"volume": "ball.vol.json"}], "ground": {"albedo": "grey"}})");
+  writeFile(dir / "garbage.exr", "this is not an image");
+  Volume no_ior = readVolume(dir / "ball.vol.json");
+  no_ior.fields.erase("ior");
+  writeVolume(no_ior, dir / "noior.vol.json");
   // A volume without ior_grad.
   Volume v = readVolume(dir / "ball.vol.json");
   v.fields.erase("ior_grad");
@@ -68,7 +80,15 @@ TEST(ViewerCli, BadInputExitsTwo) {
       {{"nograd.vol.json", "--render", "x.png"}, "ior_grad"},
       {{"ball.vol.json", "--render", "x.png", "--size", "10by10"}, "--size"},
       {{"ball.vol.json", "--render", "x.jpg"}, ".png or .exr"},
-      {{"ball.vol.json", "--render", "x.png", "--env", "sky"}, "--env"},
+      {{"ball.vol.json", "--render", "x.png", "--env", "nebula"}, "--env"},
+      {{"ball.vol.json", "--render", "x.png", "--env", "uniform:1,-1,0"}, "--env"},
+      {{"ball.vol.json", "--render", "x.png", "--env", "missing.exr"}, "missing.exr"},
+      {{"ball.vol.json", "--render", "x.png", "--env", "garbage.exr"}, "garbage.exr"},
+      {{"env_missing.json", "--render", "x.png"}, "nowhere.exr"},
+      {{"env_unknown.json", "--render", "x.png"}, "environment.procedural"},
+      {{"ground_type.json", "--render", "x.png"}, "ground.albedo"},
+      {{"noior.vol.json", "--render", "x.png"}, "ior"},
+      {{"ball.vol.json", "--render", "x.png", "--integrator", "leapfrog"}, "--integrator"},
       {{"ball.vol.json", "--render", "x.png", "--camera", "0,0,1:0,0"}, "--camera"},
   };
   for (const Case& c : cases) {
@@ -77,6 +97,50 @@ TEST(ViewerCli, BadInputExitsTwo) {
     EXPECT_NE(r.output.find(c.expected), std::string::npos) << "expected '" << c.expected << "' in: " << r.output;
     EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
   }
+}
+
+// A scene as a user writes it: two baked objects (the second seen through the first), a ground
+// plane, the procedural sky; the flags that switch terms off run too.
+TEST(ViewerCli, RendersABakedSceneWithGroundSkyAndTwoObjects) {
+  TempDir dir;
+  ProgramResult r = runProgram(VOXELIZE_EXE,
+                               {"procedural:sphere,r=0.4,ior=1.5", "-o", "glass.vol.json", "--res", "24",
+                                "--bounds", "-1,-0.9,-1,1,1.1,1", "--quiet"},
+                               dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = runProgram(LIGHTSIM_EXE,
+                 {"glass.vol.json", "-o", "baked.vol.json", "--light", "directional:0,-1,0", "--backend", "cpu", "--quiet"},
+                 dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  writeFile(dir / "scene.json", R"({
+    "camera": {"eye": [0, 2.5, 4.5], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 40},
+    "environment": {"procedural": "sky", "intensity": 0.5},
+    "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": [1, 1, 1]}],
+    "ground": {"point": [0, -0.8, 0], "normal": [0, 1, 0], "albedo": [0.8, 0.8, 0.8], "half_extent": 4},
+    "objects": [{"volume": "baked.vol.json", "translate": [0, 0, 1]},
+                {"volume": "baked.vol.json", "translate": [0.5, 0, -1], "rotate_deg": [0, 30, 0], "scale": 1.2}],
+    "render": {"size": [64, 48], "step_voxels": 0.5, "exposure": 0, "tonemap": "aces"}
+  })");
+  r = runProgram(VIEWER_EXE, {"scene.json", "--render", "scene.exr", "--quiet"}, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  Image image = readImage(dir / "scene.exr");
+  ASSERT_EQ(image.width, 64);
+  ASSERT_EQ(image.height, 48);
+  // The bottom row sees the lit ground: ρE/π = 0.8/π from the light plus the sky's share.
+  const float* ground = image.at(2, 47);
+  EXPECT_GT(ground[1], 0.8f / 3.1416f);
+  EXPECT_LT(ground[1], 1.0f);
+  // Every term switched off and the other integrator: only the environment and straight rays are
+  // left, so the bottom row sees the checkerboard's lower cells (no ground).
+  r = runProgram(VIEWER_EXE,
+                 {"scene.json", "--render", "flags.exr", "--no-fresnel", "--no-ground", "--no-refraction",
+                  "--no-scattering", "--no-attenuation", "--no-emission", "--no-dispersion", "--no-skip",
+                  "--integrator", "rk4", "--env", "checker:1,1,1", "--step", "1", "--quiet"},
+                 dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  Image flags = readImage(dir / "flags.exr");
+  const float cell = flags.at(2, 47)[1];
+  EXPECT_TRUE(std::abs(cell - 1.0f) < 1e-3f || std::abs(cell - 0.2f) < 1e-3f) << cell;
 }
 
 }  // namespace

@@ -1,15 +1,21 @@
 // viewer: renders refractive volumes along curved rays (thesis §5, §6.3; DESIGN §4.2).
 //
 //   viewer SCENE.json | VOLUME.vol.json [--render OUT.exr|OUT.png] [--size WxH]
-//          [--camera EX,EY,EZ:TX,TY,TZ:FOVY_DEG] [--env uniform:R,G,B | checker:R,G,B]
+//          [--camera EX,EY,EZ:TX,TY,TZ:FOVY_DEG] [--env FILE | uniform:R,G,B | checker[:R,G,B] | sky]
+//          [--step VOXELS] [--integrator euler|rk4] [--no-refraction] [--no-fresnel] [--no-scattering]
+//          [--no-attenuation] [--no-emission] [--no-dispersion] [--no-ground] [--no-skip]
 //
-// This is the viewer's first form: headless rendering through OSMesa/EGL of one object with
-// refraction, attenuation, emission and opaque embeddings. The interactive window, Fresnel,
-// scattering, dispersion and several objects come with the viewer issue.
+//   viewer SCENE.json | VOLUME.vol.json            (no --render: the interactive window, viewer/window.h)
+//          [--window-frames N --save OUT.exr|OUT.png ...]   (scripted window, for tests)
+//   viewer SCENE.json | VOLUME.vol.json --bench FRAMES [--size WxH] [--stats FILE.json]  (viewer/bench.h)
+//
+// Headless rendering goes through OSMesa/EGL and viewer/scene_renderer.h (the image formation of
+// thesis §5 over every object of the scene, the ground and the environment).
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -21,7 +27,12 @@
 #include "gl/context.h"
 #include "gl/shader_library.h"
 #include "viewer/camera.h"
-#include "viewer/refractive_renderer.h"
+#include "viewer/environment.h"
+#include "viewer/loaded_scene.h"
+#include "viewer/render_settings.h"
+#include "viewer/scene_renderer.h"
+#include "viewer/bench_mode.h"
+#include "viewer/window.h"
 
 namespace fs = std::filesystem;
 
@@ -38,53 +49,79 @@ glm::ivec2 parseSize(const std::string& text) {
   return {w, h};
 }
 
-// "uniform:R,G,B" or "checker:R,G,B" (bright cells); a bare "checker" is white.
-void parseEnvironment(const std::string& text, RenderSettings& settings) {
-  const auto colon = text.find(':');
-  const std::string kind = text.substr(0, colon);
-  if (kind != "uniform" && kind != "checker")
-    throw InputError("--env", text, "expected uniform:R,G,B or checker:R,G,B (environment maps come with the viewer issue)");
-  settings.environment_checker = kind == "checker";
-  settings.environment = glm::vec3(1.0f);
-  if (colon == std::string::npos) return;
-  std::istringstream in(text.substr(colon + 1));
-  char c1 = 0, c2 = 0;
-  glm::vec3 v;
-  if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof() || v.x < 0 ||
-      v.y < 0 || v.z < 0)
-    throw InputError("--env", text, "the colour must be three non-negative numbers R,G,B");
-  settings.environment = v;
-}
-
-glm::dmat4 objectToWorld(const SceneObjectSpec& o) {
-  glm::dmat4 m = glm::translate(glm::dmat4(1.0), o.translate);
-  m = glm::rotate(m, glm::radians(o.rotate_deg.z), glm::dvec3(0, 0, 1));
-  m = glm::rotate(m, glm::radians(o.rotate_deg.y), glm::dvec3(0, 1, 0));
-  m = glm::rotate(m, glm::radians(o.rotate_deg.x), glm::dvec3(1, 0, 0));
-  return glm::scale(m, glm::dvec3(o.scale));
-}
-
 int run(int argc, char** argv) {
   std::string input, output, size_text, camera_text, env_text, tonemap_text, gl_backend = "auto";
+  std::string integrator_text = "euler", output_text = "radiance";
   double step = 0.5, exposure = 0.0;
   bool quiet = false;
+  bool no_refraction = false, no_scattering = false, no_fresnel = false, no_attenuation = false,
+       no_emission = false, no_dispersion = false, no_ground = false, no_skip = false, bricks = false;
   CLI::App app{"viewer: render refractive volumes along curved rays (thesis §5, §6.3)", "viewer"};
   app.add_option("input", input, "SCENE.json or VOLUME.vol.json")->required();
   app.add_option("--render", output, "render headless into OUT.exr (linear) or OUT.png (tone-mapped)");
   app.add_option("--size", size_text, "image size WxH (default: the scene's render.size, else 512x512)");
   app.add_option("--camera", camera_text, "EX,EY,EZ:TX,TY,TZ:FOVY_DEG (default: the scene's camera, or framing the volume)");
-  app.add_option("--env", env_text, "uniform:R,G,B or checker:R,G,B (default: the scene's uniform environment, else white)");
+  app.add_option("--env", env_text,
+                 "FILE (equirectangular .exr/.hdr/...) | uniform:R,G,B | checker[:R,G,B] | sky "
+                 "(default: the scene's environment, else white)");
   app.add_option("--step", step, "ray step in voxels (default: the scene's render.step_voxels, else 0.5)")->check(CLI::Range(0.01, 4.0));
+  app.add_option("--integrator", integrator_text, "ray integrator: euler | rk4 (default euler)");
+  app.add_option("--output", output_text,
+                 "radiance (default) | exit-position | exit-direction: where (world) and in which direction "
+                 "each pixel's ray left the last volume, alpha 1 where it went through one (EXR)")
+      ->check(CLI::IsMember({"radiance", "exit-position", "exit-direction"}));
+  app.add_flag("--no-refraction", no_refraction, "straight viewing rays");
+  app.add_flag("--no-scattering", no_scattering, "leave out in-scattering of the baked light");
+  app.add_flag("--no-fresnel", no_fresnel, "leave out Fresnel reflection and transmission at boundaries");
+  app.add_flag("--no-attenuation", no_attenuation, "leave out Beer-Lambert absorption");
+  app.add_flag("--no-emission", no_emission, "leave out emission");
+  app.add_flag("--no-dispersion", no_dispersion, "one ray for R, G and B even where a dispersion field exists");
+  app.add_flag("--no-ground", no_ground, "leave out the scene's ground plane");
+  app.add_flag("--no-skip", no_skip, "march the whole box of every volume (no empty-space skipping)");
+  app.add_flag("--bricks", bricks, "cross homogeneous 4x4x4-voxel bricks in one step (off: on llvmpipe it rarely pays)");
   app.add_option("--exposure", exposure, "exposure in EV for PNG output (default: the scene's render.exposure, else 0)");
   app.add_option("--tonemap", tonemap_text, "aces | reinhard | linear, for PNG output (default: the scene's render.tonemap, else aces)");
   app.add_option("--gl", gl_backend, "OpenGL back end: auto | osmesa | egl (default auto: OSMesa, then EGL)");
+  int bench_frames = 0, window_frames = 0;
+  std::string stats_path;
+  std::vector<std::string> save_paths;
+  app.add_option("--bench", bench_frames,
+                 "time FRAMES frames headless at --size, and a bare refractive march of the same volume")
+      ->check(CLI::Range(1, 100000));
+  app.add_option("--stats", stats_path, "with --bench: write the figures as JSON");
+  app.add_option("--window-frames", window_frames, "window: render N frames, write --save and close (tests)")
+      ->check(CLI::Range(1, 100000));
+  app.add_option("--save", save_paths,
+                 "with --window-frames: OUT.exr (the window's linear image) or OUT.png (its screen pixels); repeatable")
+      ->allow_extra_args(false);
+  std::string save_ui;
+  app.add_option("--save-ui", save_ui, "with --window-frames: OUT.png of the screen with the controls panel");
   app.add_flag("-q,--quiet", quiet, "print nothing but errors");
   app.footer("Exit codes: 0 success, 1 runtime failure, 2 bad usage or bad input.");
   if (!parseCommandLine(app, argc, argv)) return kExitOk;
-  if (output.empty())
+  const bool bench = app.count("--bench") > 0;
+  const bool window_mode = output.empty() && !bench;
+  if (bench && !output.empty())
+    throw InputError("command line", "--bench", "--bench and --render are separate runs: give one");
+  if (!stats_path.empty() && !bench)
+    throw InputError("command line", "--stats", "the viewer writes --stats with --bench only");
+  if ((window_frames > 0) != !save_paths.empty())
+    throw InputError("command line", "--save", "--window-frames N and --save OUT go together");
+  if (window_frames > 0 && !window_mode)
+    throw InputError("command line", "--window-frames", "is for the window: leave out --render and --bench");
+  for (const std::string& path : save_paths) {
+    std::string ext = fs::path(path).extension().string();
+    if (ext != ".png" && ext != ".exr") throw InputError("--save", path, "the output must end in .png or .exr");
+    if (!fs::is_directory(fs::absolute(path).parent_path()))
+      throw InputError("--save", path, "its directory does not exist");
+  }
+  if (!stats_path.empty() && !fs::is_directory(fs::absolute(stats_path).parent_path()))
+    throw InputError("--stats", stats_path, "its directory does not exist");
+  if (window_mode && !gl::displayAvailable())
     throw InputError("command line", "--render",
-                     "the interactive window is not built yet: give --render OUT.png (or OUT.exr)");
-  {
+                     "no display for the viewer's window (DISPLAY and WAYLAND_DISPLAY are unset): give --render OUT.png "
+                     "(or OUT.exr) to render headless");
+  if (!output.empty()) {
     std::string ext = fs::path(output).extension().string();
     if (ext != ".png" && ext != ".exr") throw InputError("--render", output, "the output must end in .png or .exr");
     fs::path dir = fs::absolute(output).parent_path();
@@ -92,54 +129,67 @@ int run(int argc, char** argv) {
   }
 
   // The scene: a SCENE.json, or a volume alone with a camera that frames it.
-  Scene scene;
-  fs::path volume_path;
-  const bool is_scene = input.size() < 9 || input.substr(input.size() - 9) != ".vol.json";
-  if (is_scene) {
-    scene = readScene(input);
-    if (scene.objects.empty()) throw InputError(input, "objects", "the scene has no object");
-    if (scene.objects.size() > 1 && !quiet)
-      std::fprintf(stderr, "viewer: warning: %s: rendering only objects[0] (several objects come with the viewer issue)\n",
-                   input.c_str());
-    volume_path = scene.resolve(scene.objects[0].volume);
-  } else {
-    volume_path = input;
-    scene.objects.push_back(SceneObjectSpec{input});
-  }
-  const ToneMapper tonemap =
-      parseToneMapper(!tonemap_text.empty() ? tonemap_text : is_scene ? scene.render.tonemap : "aces");
-  Volume volume = readVolume(volume_path);
-  volume.require("ior", 1, volume_path.string());
-  volume.require("ior_grad", 3, volume_path.string());
-
-  Camera camera;
-  if (!camera_text.empty()) {
-    camera = parseCamera(camera_text);
-  } else if (is_scene) {
-    camera = Camera::fromSpec(scene.camera);
-  } else {
-    const glm::dvec3 center = 0.5 * (volume.grid.bounds_min + volume.grid.bounds_max);
-    const double radius = 0.5 * glm::length(volume.grid.extent());
-    camera.target = center;
-    camera.eye = center + glm::dvec3(0.0, 0.35, 1.0) * (radius / std::sin(glm::radians(camera.fov_y_deg / 2)));
-  }
-  glm::ivec2 size = size_text.empty() ? (is_scene ? scene.render.size : glm::ivec2(512, 512)) : parseSize(size_text);
-
   RenderSettings settings;
-  settings.step_voxels = is_scene && app.count("--step") == 0 ? scene.render.step_voxels : step;
-  if (!env_text.empty())
-    parseEnvironment(env_text, settings);
-  else if (is_scene && scene.environment.uniform)
-    settings.environment = glm::vec3(*scene.environment.uniform * scene.environment.intensity);
+  settings.integrator = parseRayIntegrator(integrator_text);
+  LoadedScene scene = loadScene(input);
+  const bool is_scene = !scene.bare_volume;
+  const ToneMapper tonemap =
+      parseToneMapper(!tonemap_text.empty() ? tonemap_text : is_scene ? scene.scene.render.tonemap : "aces");
+  if (!env_text.empty()) {
+    applyEnvironmentFlag(env_text, scene.scene.environment);
+    if (!scene.scene.environment.file.empty())
+      scene.scene.environment.file = fs::absolute(scene.scene.environment.file).string();
+  }
+
+  Camera camera = camera_text.empty() ? scene.camera() : parseCamera(camera_text);
+  glm::ivec2 size = size_text.empty() ? scene.scene.render.size : parseSize(size_text);
+
+  settings.step_voxels = is_scene && app.count("--step") == 0 ? scene.scene.render.step_voxels : step;
+  settings.refraction = !no_refraction;
+  settings.scattering = !no_scattering;
+  settings.fresnel = !no_fresnel;
+  settings.attenuation = !no_attenuation;
+  settings.emission = !no_emission;
+  settings.dispersion = !no_dispersion;
+  settings.ground = !no_ground;
+  settings.skip_empty_space = !no_skip;
+  settings.homogeneous_bricks = bricks;
+  settings.output = output_text == "exit-position"    ? RenderOutput::ExitPosition
+                    : output_text == "exit-direction" ? RenderOutput::ExitDirection
+                                                      : RenderOutput::Radiance;
+
+  const float exposure_ev =
+      static_cast<float>(is_scene && app.count("--exposure") == 0 ? scene.scene.render.exposure : exposure);
+  if (bench) {
+    BenchOptions options;
+    options.frames = bench_frames;
+    options.size = size;
+    options.stats_path = stats_path;
+    options.backend = gl::parseGlBackend(gl_backend);
+    options.quiet = quiet;
+    return runBenchMode(scene, settings, camera, options);
+  }
+  if (window_mode) {
+    WindowOptions options;
+    options.size = size;
+    options.title = "Eikonal viewer: " + input;
+    options.exposure_ev = exposure_ev;
+    options.tonemap = tonemap;
+    options.scripted_frames = window_frames;
+    options.save.assign(save_paths.begin(), save_paths.end());
+    options.save_ui = save_ui;
+    options.quiet = quiet;
+    return runViewerWindow(scene, settings, camera, options);
+  }
 
   gl::ContextOptions context_options;
   context_options.backend = gl::parseGlBackend(gl_backend);
   gl::GlContext context(context_options);
   gl::ShaderLibrary shaders;
-  RefractiveRenderer renderer(shaders, volume, settings, volume_path.string());
-  Image image = renderer.render(camera, size, objectToWorld(scene.objects[0]));
+  SceneRenderer renderer(shaders, scene, settings);
+  Image image = renderer.render(camera, size);
   ImageWriteOptions write;
-  write.exposure_ev = static_cast<float>(is_scene && app.count("--exposure") == 0 ? scene.render.exposure : exposure);
+  write.exposure_ev = static_cast<float>(is_scene && app.count("--exposure") == 0 ? scene.scene.render.exposure : exposure);
   write.tonemap = tonemap;
   writeImage(output, image, write);
   if (!quiet) std::fprintf(stderr, "viewer: wrote %s (%dx%d) with %s\n", output.c_str(), size.x, size.y, context.summary().c_str());

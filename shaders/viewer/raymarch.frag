@@ -1,86 +1,202 @@
 #version 330 core
-// Curved viewing rays through one refractive volume (thesis §5, §6.3) — the first, minimal form of
-// the viewer's ray caster: Euler steps of the ray equation in arc length (Eq. 5.11/5.12) with |w|
-// renormalised to n, Beer–Lambert attenuation per channel, emission, opaque embeddings, and the
-// environment in the exit direction. Fresnel, scattering and dispersion come with the viewer issue.
+// The viewer's ray caster (thesis §5 image formation, §6.3 view renderer): one curved viewing ray
+// per pixel, from the eye through every object it meets, then the ground plane or the
+// environment. Along the ray, Eq. 5.10 with L_c = ω̂·L_s + δ·R·L_r + L_e:
+//   L = Σ T(s)·L_c(s)·Δs + T(s_e)·L(x_e),
+// T the product of Beer–Lambert attenuation exp(−∫σa ds) (per channel) and the Fresnel
+// transmissions at the boundaries crossed. Objects are found along the ray, nearest box first: a
+// ray leaving one object continues into the next one it meets (so one is seen through another).
+// With DISPERSION, R, G and B follow their own rays at λ = 0.61, 0.55, 0.465 µm (thesis §3.2.7).
 //
-// Defines: the volume layout (gl::VolumeTextureLayout::glslDefines), ENV_CHECKER for a
-// checkerboard environment (latitude/longitude cells) instead of a uniform one.
+// Defines (SceneRenderer): OBJECT_COUNT, MAX_SEGMENTS, LIGHT_COUNT; GROUND, FRESNEL, ATTENUATION,
+// EMISSION, SCATTERING, DISPERSION, NO_REFRACTION, RK4; OUTPUT_EXIT_POSITION, OUTPUT_EXIT_DIRECTION;
+// the environment's ENV_*.
 #include "common/constants.glsl"
-#include "common/volume.glsl"
+#include "viewer/optics.glsl"
+#include "viewer/environment.glsl"
 
-uniform mat4 uInvViewProj;      // clip → world
-uniform vec3 uEye;              // world
-uniform mat4 uWorldToVolume;    // world → the volume's own space (thesis §6.3.1: x' = M⁻¹x)
-uniform mat3 uVolumeToWorldDir; // directions back to world, for the environment lookup
-uniform vec3 uBoundsMin;        // the volume's box in its own space
-uniform vec3 uBoundsMax;
-uniform float uStep;            // arc length per step, volume units
-uniform int uMaxSteps;
-uniform vec3 uEnvColor;
+uniform mat4 uInvViewProj;  // clip → world
+uniform vec3 uEye;          // world
+
+// Per object: placement, its volume box and the box of its non-trivial region (volume space).
+uniform mat4 uObjWorldToVol[OBJECT_COUNT];   // M⁻¹ (§6.3.1)
+uniform mat4 uObjVolToWorld[OBJECT_COUNT];   // M
+uniform vec3 uObjBoundsMin[OBJECT_COUNT];
+uniform vec3 uObjBoundsMax[OBJECT_COUNT];
+uniform vec3 uObjActiveMin[OBJECT_COUNT];    // rays march only here (n = 1 and nothing else outside)
+uniform vec3 uObjActiveMax[OBJECT_COUNT];
+uniform vec3 uObjHalfVoxel[OBJECT_COUNT];    // half a voxel in texture coordinates
+uniform vec3 uObjAbsorbingMin[OBJECT_COUNT]; // the box where σa > 0 (volume space; empty: min > max)
+uniform vec3 uObjAbsorbingMax[OBJECT_COUNT];
+uniform float uObjStep[OBJECT_COUNT];        // arc length per step, volume units
+uniform int uObjMaxSteps[OBJECT_COUNT];
+uniform float uObjBoundaryGrad[OBJECT_COUNT];  // |∇n| above which the ray is in a boundary layer
+uniform vec3 uObjBrickSize[OBJECT_COUNT];    // a homogeneity brick's extent, volume units
+
+uniform float uMinTransmittance;  // early termination
+uniform float uMaxOpticalDepth;   // −ln(uMinTransmittance)
+uniform float uPixelSpread;       // radians between neighbouring pixels' rays
+uniform float uEnvLodBias;
+uniform float uReflectionLod;     // mip level of reflection lookups
+uniform vec3 uAmbientRadiance;    // the environment's diffuse radiance on an upward surface, per unit albedo
+
+#if LIGHT_COUNT > 0
+uniform vec4 uLightPos[LIGHT_COUNT];    // w = 0: direction the light travels; w = 1: position
+uniform vec3 uLightPower[LIGHT_COUNT];  // irradiance (directional) or intensity (point)
+#endif
+
+#ifdef GROUND
+uniform vec3 uGroundPoint;
+uniform vec3 uGroundNormal;
+uniform vec3 uGroundAxisU;        // unit, in the plane
+uniform vec3 uGroundAxisV;
+uniform float uGroundHalfExtent;
+uniform vec3 uGroundAlbedo;
+uniform vec3 uGroundAmbient;      // albedo × the environment's diffuse radiance on the ground
+#endif
 
 in vec2 vUv;
 out vec4 outColor;
 
-vec3 environment(vec3 d) {
-#ifdef ENV_CHECKER
-  float u = atan(d.z, d.x) / TWO_PI + 0.5;
-  float v = acos(clamp(d.y, -1.0, 1.0)) / PI;
-  float c = mod(floor(u * 24.0) + floor(v * 12.0), 2.0);
-  return uEnvColor * (0.2 + 0.8 * c);
-#else
-  return uEnvColor;
+struct Ray {
+  vec3 x;         // world position
+  vec3 d;         // world direction, unit
+  vec3 radiance;  // gathered so far
+  vec3 T;         // transmittance so far (Beer–Lambert × Fresnel)
+  bool done;      // ended on an opaque surface, the ground, or absorbed
+  bool entered;   // went through a volume
+  vec3 exitX;     // world position where it last left a volume
+};
+
+// Irradiance from the scene's lights at x on a surface of normal N, nothing in the way.
+vec3 unoccludedIrradiance(vec3 x, vec3 N) {
+  vec3 E = vec3(0.0);
+#if LIGHT_COUNT > 0
+  for (int i = 0; i < LIGHT_COUNT; ++i) {
+    if (uLightPos[i].w == 0.0) {
+      E += uLightPower[i] * max(0.0, -dot(N, uLightPos[i].xyz));
+    } else {
+      vec3 L = uLightPos[i].xyz - x;
+      float r2 = max(dot(L, L), 1e-12);
+      E += uLightPower[i] * max(0.0, dot(N, L) * inversesqrt(r2)) / r2;
+    }
+  }
 #endif
+  return E;
 }
 
-// Slab test; false when the ray misses the box or it lies behind the origin.
-bool intersectBox(vec3 o, vec3 d, out float tNear, out float tFar) {
-  vec3 inv = 1.0 / d;
-  vec3 t0 = (uBoundsMin - o) * inv;
-  vec3 t1 = (uBoundsMax - o) * inv;
-  vec3 lo = min(t0, t1);
-  vec3 hi = max(t0, t1);
-  tNear = max(max(lo.x, lo.y), lo.z);
-  tFar = min(min(hi.x, hi.y), hi.z);
-  return tFar > max(tNear, 0.0);
+#ifdef GROUND
+bool onGround(vec3 xw) {
+  vec3 q = xw - uGroundPoint;
+  return abs(dot(q, uGroundAxisU)) <= uGroundHalfExtent && abs(dot(q, uGroundAxisV)) <= uGroundHalfExtent;
+}
+
+// Distance along the ray to the ground, seen from above; a huge number when it misses.
+float groundDistance(vec3 x, vec3 d) {
+  float height = dot(x - uGroundPoint, uGroundNormal);
+  float dn = dot(d, uGroundNormal);
+  if (height <= 0.0 || dn >= 0.0) return 1e30;
+  float t = -height / dn;
+  return onGround(x + t * d) ? t : 1e30;
+}
+
+vec3 groundRadiance(vec3 xw);  // after the objects: it asks each one for its baked irradiance
+const float kGroundBlendVoxels = 3.0;  // the bake fades into the unoccluded light over this margin
+#endif
+
+// @OBJECTS@
+
+#ifdef GROUND
+// Lambertian ground: ρE/π with the baked irradiance where it lies inside a baked volume (caustics,
+// shadows), the scene's lights unoccluded elsewhere (DESIGN §5 "Receivers"), plus the environment.
+vec3 groundRadiance(vec3 xw) {
+  vec3 baked;
+  float weight = bakedGroundIrradiance(xw, baked);
+  vec3 E = weight > 0.0 ? mix(unoccludedIrradiance(xw, uGroundNormal), baked, weight)
+                        : unoccludedIrradiance(xw, uGroundNormal);
+  return uGroundAlbedo * E * INV_PI + uGroundAmbient;
+}
+#endif
+
+// Follows the ray through the objects it meets, nearest box first, and onto the ground.
+void trace(inout Ray r, float cauchy) {
+  int last = -1;
+  for (int segment = 0; segment < MAX_SEGMENTS; ++segment) {
+    float tBest = 1e30;
+    int next = -1;
+    for (int j = 0; j < OBJECT_COUNT; ++j) {
+      if (j == last) continue;  // a straight ray does not come back into a box it left
+      vec3 o = (uObjWorldToVol[j] * vec4(r.x, 1.0)).xyz;
+      vec3 dv = mat3(uObjWorldToVol[j]) * r.d;  // not normalised: t stays in world units
+      float t0, t1;
+      if (intersectBox(o, dv, uObjActiveMin[j], uObjActiveMax[j], t0, t1) && max(t0, 0.0) < tBest) {
+        tBest = max(t0, 0.0);
+        next = j;
+      }
+    }
+#ifdef GROUND
+    float tGround = groundDistance(r.x, r.d);
+    if (tGround < tBest) {
+      r.x += tGround * r.d;
+      r.radiance += r.T * groundRadiance(r.x);
+      r.done = true;
+      return;
+    }
+#endif
+    if (next < 0) return;
+    r.x += tBest * r.d;
+    marchObject(next, r, cauchy);
+    if (r.done) return;
+    last = next;
+  }
+}
+
+Ray primaryRay() {
+  vec4 far = uInvViewProj * vec4(vUv * 2.0 - 1.0, 1.0, 1.0);
+  Ray r;
+  r.x = uEye;
+  r.d = normalize(far.xyz / far.w - uEye);
+  r.radiance = vec3(0.0);
+  r.T = vec3(1.0);
+  r.done = false;
+  r.entered = false;
+  r.exitX = uEye;
+  return r;
+}
+
+// The environment in the exit direction, at the mip level of the ray's footprint: refracted rays
+// diverge, so their pixel covers more of the map (dFdx/dFdy of the exit direction; call in uniform
+// control flow).
+vec3 finish(Ray r) {
+  float spread = max(length(dFdx(r.d)), length(dFdy(r.d)));
+  float lod = envLod(max(spread, uPixelSpread)) + uEnvLodBias;
+  if (r.done) return r.radiance;
+  return r.radiance + r.T * environmentRadiance(r.d, lod);
 }
 
 void main() {
-  vec4 far = uInvViewProj * vec4(vUv * 2.0 - 1.0, 1.0, 1.0);
-  vec3 dirWorld = normalize(far.xyz / far.w - uEye);
-  vec3 o = (uWorldToVolume * vec4(uEye, 1.0)).xyz;
-  vec3 d = normalize(mat3(uWorldToVolume) * dirWorld);
-
-  vec3 radiance = vec3(0.0);
-  vec3 transmittance = vec3(1.0);
-  float tNear, tFar;
-  if (intersectBox(o, d, tNear, tFar)) {
-    vec3 extent = uBoundsMax - uBoundsMin;
-    // Start a hair inside the box: exactly on its face, rounding would put some rays outside and
-    // end their march before it began (speckles of unrefracted rays).
-    vec3 x = o + d * (max(tNear, 0.0) + 1e-4 * length(extent));
-    float n = volumeIor((x - uBoundsMin) / extent);
-    vec3 w = d * n;  // |w| = n along an exact ray
-    for (int i = 0; i < uMaxSteps; ++i) {
-      vec3 uvw = (x - uBoundsMin) / extent;
-      if (any(lessThan(uvw, vec3(0.0))) || any(greaterThan(uvw, vec3(1.0)))) break;
-      vec4 opaque = volumeOpaque(uvw);
-      if (opaque.a > 0.5) {
-        radiance += transmittance * opaque.rgb * uEnvColor;
-        transmittance = vec3(0.0);
-        break;
-      }
-      transmittance *= exp(-volumeSigmaA(uvw) * uStep);   // Beer–Lambert
-      radiance += transmittance * volumeEmission(uvw) * uStep;
-      vec3 gradN = volumeIorGrad(uvw);
-      x += uStep * w / n;                                   // Eq. 5.11: dx/ds = w / n
-      w += uStep * gradN;                                   // Eq. 5.12: dw/ds = ∇n
-      n = volumeIor((x - uBoundsMin) / extent);
-      w = normalize(w) * n;                                 // keep |w| = n (DESIGN §5)
-      if (max(max(transmittance.r, transmittance.g), transmittance.b) < 1e-4) break;
-    }
-    d = normalize(w);
+#if defined(OUTPUT_EXIT_POSITION) || defined(OUTPUT_EXIT_DIRECTION)
+  Ray r = primaryRay();
+  trace(r, 0.0);
+#ifdef OUTPUT_EXIT_POSITION
+  outColor = vec4(r.exitX, r.entered ? 1.0 : 0.0);
+#else
+  outColor = vec4(r.d, r.entered ? 1.0 : 0.0);
+#endif
+#elif defined(DISPERSION)
+  // Cauchy terms 1/λ² − 1/λ_d² (µm⁻²) of the three channels, λ_d = 0.5876 µm (DESIGN §4.1).
+  const vec3 lambda = vec3(0.61, 0.55, 0.465);
+  vec3 cauchy = 1.0 / (lambda * lambda) - vec3(1.0 / (0.5876 * 0.5876));
+  vec3 colour;
+  for (int c = 0; c < 3; ++c) {
+    Ray r = primaryRay();
+    trace(r, cauchy[c]);
+    colour[c] = finish(r)[c];
   }
-  radiance += transmittance * environment(normalize(uVolumeToWorldDir * d));
-  outColor = vec4(radiance, 1.0);
+  outColor = vec4(colour, 1.0);
+#else
+  Ray r = primaryRay();
+  trace(r, 0.0);
+  outColor = vec4(finish(r), 1.0);
+#endif
 }

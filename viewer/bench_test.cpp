@@ -1,0 +1,104 @@
+// The --bench machinery: the median, the bare march's exact step count (against the count worked
+// out by hand for a straight ray through a homogeneous cube), its curved rays (the deflection of
+// a linear index gradient), and that the report's figures are consistent. No time is asserted.
+#include "viewer/bench.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "gl/context.h"
+
+namespace eik {
+namespace {
+
+// A 16³ cube [-0.5, 0.5]³ with n = n0 + g·x.
+Volume cube(float n0, float g) {
+  Volume v;
+  v.grid.dims = glm::ivec3(16);
+  v.grid.bounds_min = glm::dvec3(-0.5);
+  v.grid.bounds_max = glm::dvec3(0.5);
+  Field& ior = v.addField("ior", 1);
+  Field& grad = v.addField("ior_grad", 3);
+  for (int k = 0; k < 16; ++k)
+    for (int j = 0; j < 16; ++j)
+      for (int i = 0; i < 16; ++i) {
+        const std::size_t idx = v.grid.index(i, j, k);
+        ior.data[idx] = n0 + g * static_cast<float>(v.grid.center(i, j, k).x);
+        grad.data[3 * idx] = g;
+      }
+  return v;
+}
+
+TEST(Bench, MedianOfOddAndEvenCounts) {
+  EXPECT_EQ(medianOf({}), 0.0);
+  EXPECT_EQ(medianOf({5.0}), 5.0);
+  EXPECT_EQ(medianOf({9.0, 1.0, 5.0}), 5.0);
+  EXPECT_EQ(medianOf({4.0, 1.0, 100.0, 2.0}), 3.0);
+}
+
+TEST(Bench, BareMarchCountsTheStepsOfAStraightRay) {
+  gl::GlContext context;
+  gl::ShaderLibrary shaders;
+  BareMarch bare(shaders, cube(1.5f, 0.0f), glm::dmat4(1.0), 0.5);
+  EXPECT_DOUBLE_EQ(bare.stepLength(), 1.0 / 32.0);  // half a voxel of 1/16
+  const Camera camera{{0.0, 0.0, 3.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 30.0};
+  Image image = bare.render(camera, glm::ivec2(33, 33));
+  // The centre ray crosses 1 unit of material from 1e-4·|extent| inside the front face: samples at
+  // s0 + k/32 ≤ 1, i.e. 32 of them; constant n: it leaves along -z unbent.
+  const float* centre = image.at(16, 16);
+  EXPECT_NEAR(centre[3], 32.0f, 0.5f);
+  EXPECT_NEAR(centre[0], 0.5f, 1e-5f);
+  EXPECT_NEAR(centre[1], 0.5f, 1e-5f);
+  EXPECT_NEAR(centre[2], 0.0f, 1e-5f);
+  EXPECT_EQ(image.at(0, 0)[3], 0.0f);  // a corner ray misses the cube: no steps
+  double sum = 0.0;
+  for (std::size_t p = 3; p < image.pixels.size(); p += 4) sum += image.pixels[p];
+  EXPECT_EQ(bare.countSteps(camera, glm::ivec2(33, 33)), sum);
+  EXPECT_GT(sum, 32.0 * 50);  // many rays cross the cube
+}
+
+TEST(Bench, BareMarchBendsRaysTowardsHigherIndex) {
+  gl::GlContext context;
+  gl::ShaderLibrary shaders;
+  // n = 1.5 + 0.2·x: over a path of length 1 along -z, w gains ∇n·L = (0.2, 0, 0), so the exit
+  // direction is tilted by about 0.2 / 1.5 towards +x (first order).
+  BareMarch bare(shaders, cube(1.5f, 0.2f), glm::dmat4(1.0), 0.25);
+  const Camera camera{{0.0, 0.0, 3.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 30.0};
+  Image image = bare.render(camera, glm::ivec2(33, 33));
+  const float dx = 2.0f * image.at(16, 16)[0] - 1.0f;
+  EXPECT_NEAR(dx, 0.2f / 1.5f, 0.015f);
+  EXPECT_NEAR(2.0f * image.at(16, 16)[1] - 1.0f, 0.0f, 1e-4f);
+}
+
+TEST(Bench, ReportFiguresAreConsistent) {
+  gl::GlContext context;
+  gl::ShaderLibrary shaders;
+  BareMarch bare(shaders, cube(1.5f, 0.1f), glm::dmat4(1.0), 0.5);
+  const Camera camera{{0.0, 0.0, 3.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 30.0};
+  const glm::ivec2 size(24, 16);
+  int full_calls = 0;
+  BenchReport r = runBench([&] { ++full_calls; bare.draw(camera, size); }, bare, camera, size, 5);
+  EXPECT_EQ(full_calls, 6);  // 5 timed + 1 warm-up
+  int calls = 0;
+  EXPECT_EQ(timeFrames([&] { ++calls; }, 3, false).size(), 3u);
+  EXPECT_EQ(calls, 3);
+  EXPECT_EQ(timeFrames([&] { ++calls; }, 2).size(), 2u);
+  EXPECT_EQ(calls, 6);  // and one warm-up
+  ASSERT_EQ(r.full.frame_ms.size(), 5u);
+  ASSERT_EQ(r.bare.frame_ms.size(), 5u);
+  EXPECT_EQ(r.full.median_ms, medianOf(r.full.frame_ms));
+  EXPECT_EQ(r.bare.steps_per_frame, bare.countSteps(camera, size));
+  EXPECT_EQ(r.full.steps_per_frame, r.bare.steps_per_frame);
+  EXPECT_GT(r.bare.steps_per_frame, 0.0);
+  EXPECT_NEAR(r.bare.samples_per_s, r.bare.steps_per_frame / (r.bare.median_ms / 1000.0), 1e-6 * r.bare.samples_per_s);
+  EXPECT_NEAR(r.ratio_full_over_bare, r.full.median_ms / r.bare.median_ms, 1e-12);
+  nlohmann::json j = benchReportJson(r);
+  EXPECT_EQ(j["size"][0], 24);
+  EXPECT_EQ(j["full"]["frame_ms"].size(), 5u);
+  EXPECT_TRUE(j.contains("ratio_full_over_bare"));
+  EXPECT_NE(formatBenchReport(r).find("full/bare"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace eik

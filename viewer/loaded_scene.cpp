@@ -1,0 +1,130 @@
+#include "viewer/loaded_scene.h"
+
+#include <cmath>
+#include <utility>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "core/error.h"
+
+namespace eik {
+namespace {
+
+bool endsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// The viewer needs n and ∇n (Eq. 5.11/5.12); every other field is optional.
+void requireOptics(const Volume& volume, const std::string& source) {
+  volume.require("ior", 1, source);
+  volume.require("ior_grad", 3, source);
+}
+
+// The light a bare volume was baked with (lightsim's "light" manifest entry), if it is one.
+std::vector<SceneLightSpec> bakedLights(const Volume& volume) {
+  std::vector<SceneLightSpec> lights;
+  const auto it = volume.metadata.find("light");
+  if (it == volume.metadata.end() || !it->is_object()) return lights;
+  try {
+    const nlohmann::json& j = *it;
+    const std::string type = j.value("type", std::string());
+    auto vec = [&](const char* key, glm::dvec3 fallback) {
+      if (!j.contains(key) || !j.at(key).is_array() || j.at(key).size() != 3) return fallback;
+      return glm::dvec3(j.at(key)[0].get<double>(), j.at(key)[1].get<double>(), j.at(key)[2].get<double>());
+    };
+    SceneLightSpec light;
+    if (type == "directional") {
+      light.type = SceneLightSpec::Type::Directional;
+      light.direction = vec("direction", light.direction);
+      if (glm::length(light.direction) > 0) light.direction = glm::normalize(light.direction);
+      light.irradiance = vec("irradiance", light.irradiance);
+      lights.push_back(light);
+    } else if (type == "point") {
+      light.type = SceneLightSpec::Type::Point;
+      light.position = vec("position", light.position);
+      light.intensity = vec("intensity", light.intensity);
+      lights.push_back(light);
+    }
+  } catch (const nlohmann::json::exception&) {
+    lights.clear();  // metadata is informative here; a malformed entry only loses the ground light
+  }
+  return lights;
+}
+
+}  // namespace
+
+glm::dmat4 objectToWorld(const SceneObjectSpec& o) {
+  glm::dmat4 m = glm::translate(glm::dmat4(1.0), o.translate);
+  m = glm::rotate(m, glm::radians(o.rotate_deg.z), glm::dvec3(0, 0, 1));
+  m = glm::rotate(m, glm::radians(o.rotate_deg.y), glm::dvec3(0, 1, 0));
+  m = glm::rotate(m, glm::radians(o.rotate_deg.x), glm::dvec3(1, 0, 0));
+  return glm::scale(m, glm::dvec3(o.scale));
+}
+
+SceneCameraSpec framingCamera(const GridSpec& grid, double fov_y_deg) {
+  SceneCameraSpec camera;
+  const glm::dvec3 center = 0.5 * (grid.bounds_min + grid.bounds_max);
+  const double radius = 0.5 * glm::length(grid.extent());
+  camera.target = center;
+  camera.eye = center + glm::dvec3(0.0, 0.35, 1.0) * (radius / std::sin(glm::radians(fov_y_deg / 2)));
+  camera.fov_y_deg = fov_y_deg;
+  return camera;
+}
+
+LoadedScene sceneFromVolume(Volume volume, const std::string& source) {
+  requireOptics(volume, source);
+  LoadedScene loaded;
+  loaded.bare_volume = true;
+  loaded.source = source;
+  loaded.scene.camera = framingCamera(volume.grid);
+  loaded.scene.environment.uniform = glm::dvec3(1.0);
+  loaded.scene.lights = bakedLights(volume);
+  loaded.scene.render.size = glm::ivec2(512, 512);
+  loaded.scene.objects.push_back(SceneObjectSpec{source});
+  LoadedObject object;
+  object.source = source;
+  object.volume = std::move(volume);
+  loaded.objects.push_back(std::move(object));
+  return loaded;
+}
+
+LoadedScene sceneFromVolumes(Scene scene, std::vector<Volume> volumes) {
+  if (volumes.size() != scene.objects.size())
+    throw InputError("scene", "objects", "expected one volume per object");
+  if (scene.objects.empty()) throw InputError("scene", "objects", "the scene has no object");
+  LoadedScene loaded;
+  loaded.source = "scene";
+  for (std::size_t i = 0; i < volumes.size(); ++i) {
+    LoadedObject object;
+    object.source = scene.objects[i].volume.empty() ? "objects[" + std::to_string(i) + "]" : scene.objects[i].volume;
+    requireOptics(volumes[i], object.source);
+    object.volume = std::move(volumes[i]);
+    object.object_to_world = objectToWorld(scene.objects[i]);
+    loaded.objects.push_back(std::move(object));
+  }
+  loaded.scene = std::move(scene);
+  return loaded;
+}
+
+LoadedScene loadScene(const std::filesystem::path& input) {
+  const std::string text = input.string();
+  if (endsWith(text, ".vol.json")) return sceneFromVolume(readVolume(input), text);
+  LoadedScene loaded;
+  loaded.source = text;
+  loaded.scene = readScene(input);
+  if (loaded.scene.objects.empty()) throw InputError(text, "objects", "the scene has no object");
+  for (std::size_t i = 0; i < loaded.scene.objects.size(); ++i) {
+    const SceneObjectSpec& spec = loaded.scene.objects[i];
+    if (!(spec.scale > 0) || !std::isfinite(spec.scale))
+      throw InputError(text, "objects[" + std::to_string(i) + "].scale", "must be a positive number");
+    LoadedObject object;
+    object.source = loaded.scene.resolve(spec.volume).string();
+    object.volume = readVolume(object.source);
+    requireOptics(object.volume, object.source);
+    object.object_to_world = objectToWorld(spec);
+    loaded.objects.push_back(std::move(object));
+  }
+  return loaded;
+}
+
+}  // namespace eik

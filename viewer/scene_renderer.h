@@ -1,0 +1,57 @@
+// The viewer's renderer (thesis §6.3): every object of a LoadedScene as a bounding-box proxy, one
+// curved viewing ray per pixel in a single full-screen pass (shaders/viewer/raymarch.frag), carried
+// from the eye through the objects it meets, nearest box first, so one object is seen through
+// another; in each object's own space (x' = M⁻¹x, ∇n' = M⁻ᵀ∇n, §6.3.1) the ray is marched through
+// the box of the volume's non-trivial region (shaders/viewer/object.glsl, one instance per object)
+// with the image formation of Eq. 5.10 (in-scattering of the bake, Fresnel, Beer–Lambert,
+// emission, opaque embeddings), then it meets the ground plane or the environment
+// (viewer/environment.h). Output is linear HDR radiance; tone mapping is the caller's.
+// Where a volume's material touches its box, the faces are sharp interfaces (Snell, Fresnel).
+// Limit: objects' boxes should not overlap (a ray marches one box at a time).
+#pragma once
+
+#include <memory>
+
+#include <glm/glm.hpp>
+
+#include "core/image_io.h"
+#include "gl/shader_library.h"
+#include "viewer/camera.h"
+#include "viewer/loaded_scene.h"
+#include "viewer/render_settings.h"
+
+namespace eik {
+
+class SceneRenderer {
+ public:
+  // Needs a current GL context (kept current while the renderer is used and destroyed). Uploads
+  // every object's volume and the environment map; InputError naming the file and field if a
+  // volume lacks ior/ior_grad, is too large for the GPU, or the environment map cannot be read.
+  // Keeps a reference to `shaders` (setSettings recompiles): it must outlive the renderer.
+  SceneRenderer(const gl::ShaderLibrary& shaders, const LoadedScene& scene, const RenderSettings& settings);
+  ~SceneRenderer();
+  SceneRenderer(const SceneRenderer&) = delete;
+  SceneRenderer& operator=(const SceneRenderer&) = delete;
+
+  // May recompile shader variants (cheap when nothing that selects a variant changed).
+  void setSettings(const RenderSettings& settings);
+  const RenderSettings& settings() const;
+
+  // The direction the light travels (world), for the parts that are not baked: the ground outside
+  // the volumes and the sky's sun. Starts as the scene's first directional light.
+  void setLightDirection(glm::dvec3 world_dir);
+  glm::dvec3 lightDirection() const;
+
+  // Linear HDR radiance into the currently bound framebuffer (RGBA32F), viewport (0,0,size).
+  void draw(const Camera& camera, glm::ivec2 size);
+  // Offscreen RGBA32F target + readback; rows top to bottom.
+  Image render(const Camera& camera, glm::ivec2 size);
+
+  int objectCount() const;  // objects drawn (all of the scene's)
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace eik

@@ -1,0 +1,355 @@
+#include "viewer/window.h"
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <memory>
+
+#include "core/error.h"
+#include "core/image_io.h"
+#include "gl/context.h"
+#include "gl/framebuffer.h"
+#include "gl/shader_library.h"
+#include "viewer/display_pass.h"
+#include "viewer/orbit_camera.h"
+#include "viewer/scene_renderer.h"
+
+namespace fs = std::filesystem;
+
+namespace eik {
+
+namespace {
+
+// An orthonormal pair perpendicular to `up` (unit): the azimuth's 0° and 90° directions.
+void perpendicularPair(const glm::dvec3& up, glm::dvec3& a, glm::dvec3& b) {
+  const glm::dvec3 other = std::abs(up.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0);
+  a = glm::normalize(glm::cross(glm::cross(up, other), up));  // `other` projected into the plane
+  b = glm::cross(up, a);
+}
+
+glm::dvec3 unitOr(const glm::dvec3& v, const glm::dvec3& fallback) {
+  return glm::length(v) > 1e-12 ? glm::normalize(v) : fallback;
+}
+
+// Dear ImGui on a GLFW window, shut down with the object.
+class ImGuiLayer {
+ public:
+  explicit ImGuiLayer(GLFWwindow* window) {
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini left in the user's directory
+    ImGui::StyleColorsDark();
+    if (!ImGui_ImplGlfw_InitForOpenGL(window, true)) throw RuntimeError("Dear ImGui: GLFW back end failed to start");
+    if (!ImGui_ImplOpenGL3_Init("#version 330 core")) {
+      ImGui_ImplGlfw_Shutdown();
+      throw RuntimeError("Dear ImGui: OpenGL 3 back end failed to start");
+    }
+  }
+  ~ImGuiLayer() {
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+  }
+  ImGuiLayer(const ImGuiLayer&) = delete;
+  ImGuiLayer& operator=(const ImGuiLayer&) = delete;
+
+  void newFrame() {
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+  }
+  void render() {
+    ImGui::Render();
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+  }
+};
+
+Image hdrImage(const gl::Framebuffer& hdr) {
+  Image image;
+  image.width = hdr.size().x;
+  image.height = hdr.size().y;
+  image.channels = 4;
+  image.pixels = hdr.readRGBA(0);
+  gl::flipRows(image.pixels, image.width, 4);
+  return image;
+}
+
+// The back buffer as the display pass left it (sRGB-encoded values k/255), written as a PNG
+// holding exactly those 8-bit values: writeImage encodes linear → sRGB, so decode first (the
+// round trip is exact to far below half a step).
+void writeScreenPng(const fs::path& path, glm::ivec2 size) {
+  Image image;
+  image.width = size.x;
+  image.height = size.y;
+  image.channels = 4;
+  image.pixels = gl::readDefaultFramebufferRGBA(size, GL_BACK);
+  gl::flipRows(image.pixels, size.x, 4);
+  for (std::size_t i = 0; i < image.pixels.size(); ++i) {
+    if (i % 4 == 3) continue;
+    const float v = std::clamp(image.pixels[i], 0.0f, 1.0f);
+    image.pixels[i] = v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+  }
+  ImageWriteOptions write;
+  write.tonemap = ToneMapper::Linear;
+  write.exposure_ev = 0.0f;
+  writeImage(path, image, write);
+}
+
+struct Shot {
+  fs::path exr, png;
+};
+
+Shot nextShotPaths(const fs::path& prefix) {
+  for (int i = 1;; ++i) {
+    char number[16];
+    std::snprintf(number, sizeof number, "-%03d", i);
+    Shot shot{prefix.string() + number + ".exr", prefix.string() + number + ".png"};
+    if (!fs::exists(shot.exr) && !fs::exists(shot.png)) return shot;
+  }
+}
+
+const char* const kToneMapperNames[] = {"linear", "reinhard", "aces"};
+ToneMapper toneMapperAt(int index) {
+  return index == 0 ? ToneMapper::Linear : index == 1 ? ToneMapper::Reinhard : ToneMapper::Aces;
+}
+
+// The settings the panel edits.
+bool sameControls(const RenderSettings& a, const RenderSettings& b) {
+  return a.step_voxels == b.step_voxels && a.integrator == b.integrator && a.refraction == b.refraction &&
+         a.scattering == b.scattering && a.fresnel == b.fresnel && a.attenuation == b.attenuation &&
+         a.emission == b.emission && a.dispersion == b.dispersion && a.ground == b.ground &&
+         a.skip_empty_space == b.skip_empty_space;
+}
+
+}  // namespace
+
+glm::dvec3 lightDirectionFromAngles(double azimuth_deg, double elevation_deg, glm::dvec3 up) {
+  up = unitOr(up, glm::dvec3(0, 1, 0));
+  glm::dvec3 a, b;
+  perpendicularPair(up, a, b);
+  const double az = glm::radians(azimuth_deg), el = glm::radians(elevation_deg);
+  const glm::dvec3 towards_light = std::cos(el) * (std::cos(az) * a + std::sin(az) * b) + std::sin(el) * up;
+  return -towards_light;
+}
+
+glm::dvec2 lightAnglesFromDirection(glm::dvec3 travel_dir, glm::dvec3 up) {
+  up = unitOr(up, glm::dvec3(0, 1, 0));
+  glm::dvec3 a, b;
+  perpendicularPair(up, a, b);
+  const glm::dvec3 l = -unitOr(travel_dir, -up);
+  const double elevation = std::asin(std::clamp(glm::dot(l, up), -1.0, 1.0));
+  const double azimuth = std::atan2(glm::dot(l, b), glm::dot(l, a));
+  return glm::degrees(glm::dvec2(azimuth, elevation));
+}
+
+int runViewerWindow(const LoadedScene& scene, const RenderSettings& initial_settings, const Camera& initial_camera,
+                    const WindowOptions& options) {
+  const bool scripted = options.scripted_frames > 0;
+  gl::ContextOptions context_options;
+  context_options.backend = gl::GlBackend::Window;
+  context_options.size = glm::max(options.size, glm::ivec2(1));
+  context_options.title = options.title;
+  context_options.swapInterval = scripted ? 0 : 1;
+  gl::GlContext context(context_options);
+  GLFWwindow* window = context.window();
+  if (!options.quiet) std::fprintf(stderr, "viewer: window with %s\n", context.summary().c_str());
+
+  gl::ShaderLibrary shaders;
+  SceneRenderer renderer(shaders, scene, initial_settings);
+  DisplayPass display(shaders);
+  ImGuiLayer imgui(window);
+
+  RenderSettings settings = initial_settings;
+  OrbitCamera orbit(initial_camera);
+  float exposure = options.exposure_ev;
+  int tonemap = static_cast<int>(options.tonemap == ToneMapper::Linear     ? 0
+                                 : options.tonemap == ToneMapper::Reinhard ? 1
+                                                                           : 2);
+  const glm::dvec3 up = unitOr(initial_camera.up, glm::dvec3(0, 1, 0));
+  glm::dvec2 light_angles = lightAnglesFromDirection(renderer.lightDirection(), up);
+  float light_azimuth = static_cast<float>(light_angles.x);
+  float light_elevation = static_cast<float>(glm::clamp(light_angles.y, -89.0, 89.0));
+  float step = static_cast<float>(settings.step_voxels);
+  float resolution_scale = 1.0f;
+  bool show_panel = true;
+
+  gl::Framebuffer hdr;
+  bool dirty = true;
+  double render_ms = 0.0;
+  double frame_ms = 0.0;
+  std::string status;
+  int frame = 0;
+  auto last_frame = std::chrono::steady_clock::now();
+
+  // S: the current view at the window's full size (whatever the resolution slider says), rendered
+  // as `--render` renders it; a failure to write is shown, not fatal.
+  auto save_shot = [&](glm::ivec2 size) {
+    try {
+      const Shot shot = nextShotPaths(options.shot_prefix);
+      Image image = renderer.render(orbit.camera(), size);
+      writeImage(shot.exr, image);
+      ImageWriteOptions write;
+      write.exposure_ev = exposure;
+      write.tonemap = toneMapperAt(tonemap);
+      writeImage(shot.png, image, write);
+      status = "saved " + shot.exr.string() + " and " + shot.png.string();
+    } catch (const std::exception& e) {
+      status = std::string("could not save: ") + e.what();
+    }
+    if (!options.quiet) std::fprintf(stderr, "viewer: %s\n", status.c_str());
+  };
+
+  while (!context.shouldClose()) {
+    if (scripted || dirty)
+      gl::GlContext::pollEvents();
+    else
+      glfwWaitEventsTimeout(0.1);  // nothing to render: sleep until input (or a tick for the panel)
+    const glm::ivec2 fb = context.framebufferSize();
+    if (fb.x <= 0 || fb.y <= 0) {  // minimised
+      glfwWaitEvents();
+      continue;
+    }
+    imgui.newFrame();
+    ImGuiIO& io = ImGui::GetIO();
+
+    // Camera and keys, unless the panel has them.
+    if (!io.WantCaptureMouse) {
+      const double h = std::max(1.0f, io.DisplaySize.y);
+      const glm::dvec2 delta(io.MouseDelta.x, io.MouseDelta.y);
+      const bool moved = delta.x != 0.0 || delta.y != 0.0;
+      if (io.MouseDown[0] && !io.KeyShift && moved) orbit.orbitByPixels(delta.x, delta.y, h), dirty = true;
+      if ((io.MouseDown[1] || io.MouseDown[2] || (io.MouseDown[0] && io.KeyShift)) && moved)
+        orbit.panByPixels(delta.x, delta.y, h), dirty = true;
+      if (io.MouseWheel != 0.0f) orbit.zoomBySteps(io.MouseWheel), dirty = true;
+    }
+    if (!io.WantCaptureKeyboard) {
+      if (ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false) || ImGui::IsKeyPressed(GLFW_KEY_Q, false))
+        glfwSetWindowShouldClose(window, GLFW_TRUE);
+      if (ImGui::IsKeyPressed(GLFW_KEY_R, false)) orbit = OrbitCamera(initial_camera), dirty = true;
+      if (ImGui::IsKeyPressed(GLFW_KEY_H, false)) show_panel = !show_panel;
+    }
+
+    // The panel.
+    RenderSettings wanted = settings;
+    bool save_requested = !io.WantCaptureKeyboard && ImGui::IsKeyPressed(GLFW_KEY_S, false);
+    if (show_panel) {
+      ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
+      ImGui::SetNextWindowBgAlpha(0.8f);
+      ImGui::Begin("Eikonal", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+      ImGui::PushItemWidth(110.0f);
+      ImGui::Text("render %.1f ms  (%dx%d)", render_ms, hdr ? hdr.size().x : 0, hdr ? hdr.size().y : 0);
+      ImGui::Text("frame %.1f ms", frame_ms);
+      ImGui::Separator();
+      ImGui::SliderFloat("exposure (EV)", &exposure, -10.0f, 10.0f, "%.2f");
+      ImGui::Combo("tone map", &tonemap, kToneMapperNames, 3);
+      bool light_changed = ImGui::SliderFloat("light azimuth", &light_azimuth, -180.0f, 180.0f, "%.0f deg");
+      light_changed |= ImGui::SliderFloat("light elevation", &light_elevation, -89.0f, 89.0f, "%.0f deg");
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("the ground and the sky's sun; a volume's irradiance is baked");
+      if (light_changed) {
+        renderer.setLightDirection(lightDirectionFromAngles(light_azimuth, light_elevation, up));
+        dirty = true;
+      }
+      if (ImGui::SliderFloat("step (voxels)", &step, 0.05f, 4.0f, "%.2f", ImGuiSliderFlags_Logarithmic))
+        wanted.step_voxels = step;
+      int integrator = settings.integrator == RayIntegrator::RK4 ? 1 : 0;
+      const char* integrators[] = {"Euler", "RK4"};
+      if (ImGui::Combo("integrator", &integrator, integrators, 2))
+        wanted.integrator = integrator == 1 ? RayIntegrator::RK4 : RayIntegrator::Euler;
+      if (ImGui::SliderFloat("resolution", &resolution_scale, 0.125f, 1.0f, "%.3f")) dirty = true;
+      ImGui::Checkbox("refraction", &wanted.refraction);
+      ImGui::SameLine();
+      ImGui::Checkbox("scattering", &wanted.scattering);
+      ImGui::SameLine();
+      ImGui::Checkbox("Fresnel", &wanted.fresnel);
+      ImGui::Checkbox("attenuation", &wanted.attenuation);
+      ImGui::SameLine();
+      ImGui::Checkbox("emission", &wanted.emission);
+      ImGui::SameLine();
+      ImGui::Checkbox("dispersion", &wanted.dispersion);
+      ImGui::Checkbox("ground", &wanted.ground);
+      ImGui::SameLine();
+      ImGui::Checkbox("skip empty space", &wanted.skip_empty_space);
+      ImGui::Separator();
+      if (ImGui::Button("save (S)")) save_requested = true;
+      ImGui::SameLine();
+      if (ImGui::Button("reset camera (R)")) orbit = OrbitCamera(initial_camera), dirty = true;
+      ImGui::TextDisabled("drag: orbit   right drag: pan   wheel: zoom");
+      ImGui::TextDisabled("H: hide panel   Esc/Q: quit");
+      if (!status.empty()) ImGui::TextWrapped("%s", status.c_str());
+      ImGui::PopItemWidth();
+      ImGui::End();
+    }
+    if (!sameControls(wanted, settings)) {
+      settings = wanted;
+      renderer.setSettings(settings);
+      dirty = true;
+    }
+
+    // Render the HDR image when something changed (always, in scripted mode).
+    // While a mouse button drags the view, a quarter of the resolution at most: llvmpipe takes about
+    // a second for a full 512² frame. The full image comes back when the button is released.
+    const bool dragging = !io.WantCaptureMouse && (io.MouseDown[0] || io.MouseDown[1] || io.MouseDown[2]);
+    const float scale = scripted ? 1.0f : dragging ? std::min(resolution_scale, 0.25f) : resolution_scale;
+    const glm::ivec2 render_size = glm::max(glm::ivec2(glm::round(glm::vec2(fb) * scale)), glm::ivec2(1));
+    if (!hdr || hdr.size() != render_size) {
+      hdr = gl::Framebuffer(render_size, {gl::TextureFormat::RGBA32F});
+      dirty = true;
+    }
+    if (dirty || scripted) {
+      const auto start = std::chrono::steady_clock::now();
+      hdr.bind();
+      renderer.draw(orbit.camera(), render_size);
+      glFinish();
+      render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      dirty = false;
+    }
+
+    // Display pass into the window, then the panel on top.
+    gl::Framebuffer::bindDefault(fb);
+    display.draw(hdr.color(0), fb, exposure, toneMapperAt(tonemap));
+    ++frame;
+    bool last_scripted_frame = false;
+    if (scripted) {
+      const bool resize = options.scripted_resize.x > 0 && options.scripted_resize.y > 0;
+      if (resize && frame == 1) glfwSetWindowSize(window, options.scripted_resize.x, options.scripted_resize.y);
+      glm::ivec2 window_size(0);
+      glfwGetWindowSize(window, &window_size.x, &window_size.y);
+      const bool resized = !resize || (window_size == options.scripted_resize && hdr.size() == fb);
+      last_scripted_frame = frame >= options.scripted_frames && resized;
+      if (frame >= options.scripted_frames + 1000)
+        throw RuntimeError("the window did not take the size asked for (" + std::to_string(options.scripted_resize.x) +
+                           "x" + std::to_string(options.scripted_resize.y) + ")");
+    }
+    if (last_scripted_frame) {
+      for (const fs::path& path : options.save) {
+        if (path.extension() == ".png")
+          writeScreenPng(path, fb);
+        else
+          writeImage(path, hdrImage(hdr));
+        if (!options.quiet)
+          std::fprintf(stderr, "viewer: wrote %s (%dx%d) from the window\n", path.string().c_str(), fb.x, fb.y);
+      }
+      if (options.scripted_shot) save_requested = true;
+      glfwSetWindowShouldClose(window, GLFW_TRUE);
+    }
+    if (save_requested) save_shot(fb);
+    gl::Framebuffer::bindDefault(fb);  // the saves may have bound their own framebuffers
+    imgui.render();
+    if (last_scripted_frame && !options.save_ui.empty()) writeScreenPng(options.save_ui, fb);
+    context.swapBuffers();
+    const auto now = std::chrono::steady_clock::now();
+    frame_ms = std::chrono::duration<double, std::milli>(now - last_frame).count();
+    last_frame = now;
+  }
+  return kExitOk;
+}
+
+}  // namespace eik

@@ -1,0 +1,55 @@
+// The interactive viewer (thesis §6.3; DESIGN §4.2 "viewer without --render opens a window"): a
+// GLFW window (gl::GlContext's window back end) showing SceneRenderer's HDR image through the
+// display pass (viewer/display_pass.h), with Dear ImGui controls on top.
+//
+// Controls: left drag orbits, right or middle drag (or shift + left) pans, the wheel zooms; the
+// panel sets the light direction, exposure, tone mapper, step size, integrator, resolution scale
+// and switches refraction, scattering, Fresnel, attenuation, emission, dispersion and the ground;
+// it shows the render time. S saves the current view as EXR (linear) and PNG (tone-mapped exactly
+// as `--render OUT.png`), R resets the camera, Esc or Q quits. The image is re-rendered only when
+// something changed (llvmpipe is slow), at reduced resolution while dragging; the panel stays live.
+//
+// Scripted mode (tests, --window-frames N): renders N frames at full resolution (optionally
+// resizing the window after the first), then writes each `save` path (.exr: the window's linear HDR image; .png: the pixels the display pass put on the
+// screen, before the panel) and closes.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/tonemap.h"
+#include "viewer/camera.h"
+#include "viewer/loaded_scene.h"
+#include "viewer/render_settings.h"
+
+namespace eik {
+
+struct WindowOptions {
+  glm::ivec2 size{800, 600};  // initial window size (screen coordinates)
+  std::string title = "Eikonal viewer";
+  float exposure_ev = 0.0f;
+  ToneMapper tonemap = ToneMapper::Aces;
+  int scripted_frames = 0;                  // > 0: scripted mode
+  std::vector<std::filesystem::path> save;  // scripted mode's outputs
+  std::filesystem::path save_ui;            // scripted mode: a PNG of the screen with the panel (docs)
+  std::filesystem::path shot_prefix = "eikonal-shot";  // S key: PREFIX-NNN.exr and .png
+  bool scripted_shot = false;  // scripted mode: also "press S" on the last frame (tests)
+  glm::ivec2 scripted_resize{0};  // scripted mode: resize the window to this after the first frame
+                                  // (tests), and go on until the window has taken the new size
+  bool quiet = false;
+};
+
+// Opens the window (RuntimeError when GLFW cannot), renders `scene` until the user quits (or the
+// scripted frames are done). Returns the exit code (0).
+int runViewerWindow(const LoadedScene& scene, const RenderSettings& settings, const Camera& camera,
+                    const WindowOptions& options);
+
+// The light's direction of travel from an azimuth and elevation (degrees) of the direction it
+// comes FROM, about `up` (the azimuth's zero is the projection of a fixed perpendicular), and back.
+glm::dvec3 lightDirectionFromAngles(double azimuth_deg, double elevation_deg, glm::dvec3 up);
+glm::dvec2 lightAnglesFromDirection(glm::dvec3 travel_dir, glm::dvec3 up);
+
+}  // namespace eik
