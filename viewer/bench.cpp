@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "gl/framebuffer.h"
+#include "viewer/scene_renderer.h"
 
 namespace eik {
 
@@ -80,13 +81,7 @@ Image BareMarch::render(const Camera& camera, glm::ivec2 size) const {
   gl::Framebuffer target(size, {gl::TextureFormat::RGBA32F});
   target.bind();
   draw(camera, size);
-  Image image;
-  image.width = size.x;
-  image.height = size.y;
-  image.channels = 4;
-  image.pixels = target.readRGBA(0);
-  gl::flipRows(image.pixels, size.x, 4);
-  return image;
+  return readLinearImage(target);
 }
 
 double BareMarch::countSteps(const Camera& camera, glm::ivec2 size) const {

@@ -419,12 +419,16 @@ Image SceneRenderer::render(const Camera& camera, glm::ivec2 size) {
   gl::Framebuffer target(size, {gl::TextureFormat::RGBA32F});
   target.bind();
   draw(camera, size);
+  return readLinearImage(target);
+}
+
+Image readLinearImage(const gl::Framebuffer& target) {
   Image image;
-  image.width = size.x;
-  image.height = size.y;
+  image.width = target.size().x;
+  image.height = target.size().y;
   image.channels = 4;
   image.pixels = target.readRGBA(0);
-  gl::flipRows(image.pixels, size.x, 4);
+  gl::flipRows(image.pixels, image.width, 4);
   return image;
 }
 

@@ -15,6 +15,7 @@
 #include <glm/glm.hpp>
 
 #include "core/image_io.h"
+#include "gl/framebuffer.h"
 #include "gl/shader_library.h"
 #include "viewer/camera.h"
 #include "viewer/loaded_scene.h"
@@ -53,5 +54,8 @@ class SceneRenderer {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// Attachment 0 of an RGBA32F framebuffer as a linear RGBA image, rows top to bottom.
+Image readLinearImage(const gl::Framebuffer& target);
 
 }  // namespace eik

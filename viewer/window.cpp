@@ -72,16 +72,6 @@ class ImGuiLayer {
   }
 };
 
-Image hdrImage(const gl::Framebuffer& hdr) {
-  Image image;
-  image.width = hdr.size().x;
-  image.height = hdr.size().y;
-  image.channels = 4;
-  image.pixels = hdr.readRGBA(0);
-  gl::flipRows(image.pixels, image.width, 4);
-  return image;
-}
-
 // The back buffer as the display pass left it (sRGB-encoded values k/255), written as a PNG
 // holding exactly those 8-bit values: writeImage encodes linear → sRGB, so decode first (the
 // round trip is exact to far below half a step).
@@ -333,7 +323,7 @@ int runViewerWindow(const LoadedScene& scene, const RenderSettings& initial_sett
         if (path.extension() == ".png")
           writeScreenPng(path, fb);
         else
-          writeImage(path, hdrImage(hdr));
+          writeImage(path, readLinearImage(hdr));
         if (!options.quiet)
           std::fprintf(stderr, "viewer: wrote %s (%dx%d) from the window\n", path.string().c_str(), fb.x, fb.y);
       }
