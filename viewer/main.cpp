@@ -189,7 +189,7 @@ int run(int argc, char** argv) {
   SceneRenderer renderer(shaders, scene, settings);
   Image image = renderer.render(camera, size);
   ImageWriteOptions write;
-  write.exposure_ev = static_cast<float>(is_scene && app.count("--exposure") == 0 ? scene.scene.render.exposure : exposure);
+  write.exposure_ev = exposure_ev;
   write.tonemap = tonemap;
   writeImage(output, image, write);
   if (!quiet) std::fprintf(stderr, "viewer: wrote %s (%dx%d) with %s\n", output.c_str(), size.x, size.y, context.summary().c_str());
