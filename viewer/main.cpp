@@ -90,14 +90,26 @@ int run(int argc, char** argv) {
       ->check(CLI::Range(1, 100000));
   app.add_option("--stats", stats_path, "with --bench: write the figures as JSON");
   app.add_option("--window-frames", window_frames, "window: render N frames, write --save and close (tests)")
-      ->check(CLI::Range(1, 100000));
+      ->check(CLI::Range(1, 100000))
+      ->group("Scripted window (tests, screenshots)");
   app.add_option("--save", save_paths,
                  "with --window-frames: OUT.exr (the window's linear image) or OUT.png (its screen pixels); repeatable")
-      ->allow_extra_args(false);
+      ->allow_extra_args(false)
+      ->group("Scripted window (tests, screenshots)");
   std::string save_ui;
-  app.add_option("--save-ui", save_ui, "with --window-frames: OUT.png of the screen with the controls panel");
+  app.add_option("--save-ui", save_ui, "with --window-frames: OUT.png of the screen with the controls panel")
+      ->group("Scripted window (tests, screenshots)");
   app.add_flag("-q,--quiet", quiet, "print nothing but errors");
-  app.footer("Exit codes: 0 success, 1 runtime failure, 2 bad usage or bad input.");
+  app.footer(
+      "Without --render or --bench the viewer opens a window (needs a display): drag to orbit, right-drag to\n"
+      "pan, wheel to zoom, S saves EXR + PNG, R resets the camera,\n"
+      "H hides the panel, Esc or Q quits.\n"
+      "Examples:\n"
+      "  viewer scene.json                                  (the window)\n"
+      "  viewer scene.json --render out.png --size 800x600  (headless)\n"
+      "  viewer glass.baked.vol.json --render out.exr --env sky\n"
+      "  viewer scene.json --bench 20 --size 512x512 --stats bench.json\n"
+      "Exit codes: 0 success, 1 runtime failure, 2 bad usage or bad input.");
   if (!parseCommandLine(app, argc, argv)) return kExitOk;
   const bool bench = app.count("--bench") > 0;
   const bool window_mode = output.empty() && !bench;
