@@ -25,3 +25,24 @@ function(eikonal_add_tests name dir)
   gtest_discover_tests(${name} WORKING_DIRECTORY ${PROJECT_BINARY_DIR} DISCOVERY_TIMEOUT 60
                        PROPERTIES ENVIRONMENT "EIKONAL_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
 endfunction()
+
+# eikonal_add_xvfb_test(NAME TARGET FILTER): runs the tests of the gtest binary TARGET matching
+# FILTER on their own under a virtual X display (xvfb-run). In the plain (discovered) run such tests
+# skip when DISPLAY is unset; here EIKONAL_REQUIRE_DISPLAY makes a skip a failure.
+# RESOURCE_LOCK xvfb: xvfb-run -a's search for a free display number races under ctest -j.
+function(eikonal_add_xvfb_test name target filter)
+  if(NOT EIKONAL_BUILD_TESTS OR NOT TARGET ${target})
+    return()
+  endif()
+  find_program(XVFB_RUN xvfb-run)
+  if(NOT XVFB_RUN)
+    message(STATUS "xvfb-run not found: ${filter} runs only where DISPLAY is set")
+    return()
+  endif()
+  add_test(NAME ${name}
+           COMMAND ${XVFB_RUN} -a -s "-screen 0 640x480x24" $<TARGET_FILE:${target}> --gtest_filter=${filter}
+           WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
+  set_tests_properties(${name} PROPERTIES
+    ENVIRONMENT "EIKONAL_REQUIRE_DISPLAY=1;EIKONAL_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
+    RESOURCE_LOCK xvfb TIMEOUT 120)
+endfunction()
