@@ -524,7 +524,9 @@ void expectOneStepMatchesTheCpuTwin(SplitRule rule) {
   EXPECT_GT(inLayer, 0);
   // Axis: 1×2 splits (and 2×2 ones where both edges grew); Quad: 2×2 splits only.
   EXPECT_GT(splits[rule == SplitRule::Axis ? 2 : 4], 0);
-  if (rule == SplitRule::Quad) EXPECT_EQ(splits[2], 0);
+  if (rule == SplitRule::Quad) {
+    EXPECT_EQ(splits[2], 0);
+  }
   EXPECT_LT(worstX, 1e-4);
   EXPECT_LT(worstW, 1e-4);
   EXPECT_LT(worstFlux, 1e-4);
