@@ -84,6 +84,15 @@ bool displayAvailable() {
   return (x11 && *x11) || (wayland && *wayland);
 }
 
+bool isSoftwareRenderer(const GlInfo& info) {
+  std::string renderer = info.renderer;
+  std::transform(renderer.begin(), renderer.end(), renderer.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  for (const char* name : {"llvmpipe", "softpipe", "swrast", "swiftshader"})
+    if (renderer.find(name) != std::string::npos) return true;
+  return false;
+}
+
 GlBackend glBackendFromEnvironment(GlBackend fallback) {
   const char* value = std::getenv("EIKONAL_GL");
   if (!value || !*value) return fallback;

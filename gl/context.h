@@ -66,6 +66,9 @@ struct GlInfo {
   int maxTextureImageUnits = 0;  // in the fragment shader
 };
 
+// Whether GL_RENDERER names a software rasterizer (llvmpipe, softpipe, swrast, SwiftShader).
+bool isSoftwareRenderer(const GlInfo& info);
+
 namespace detail {
 class ContextBackend;
 }

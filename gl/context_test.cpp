@@ -46,6 +46,19 @@ TEST(GlBackendTest, ParsesNamesAndEnvironment) {
   }
 }
 
+TEST(GlInfoTest, TellsSoftwareRasterizersFromGpus) {
+  GlInfo info;
+  for (const char* renderer : {"llvmpipe (LLVM 15.0.6, 256 bits)", "softpipe", "Mesa X11 swrast", "SwiftShader Device"}) {
+    info.renderer = renderer;
+    EXPECT_TRUE(isSoftwareRenderer(info)) << renderer;
+  }
+  for (const char* renderer : {"NVIDIA H100 80GB HBM3/PCIe/SSE2", "AMD Radeon RX 7900 XTX (radeonsi, navi31)",
+                               "Mesa Intel(R) UHD Graphics 630 (CFL GT2)", ""}) {
+    info.renderer = renderer;
+    EXPECT_FALSE(isSoftwareRenderer(info)) << renderer;
+  }
+}
+
 TEST(OSMesaContext, RendersPatternPixelExact) {
   GlContext context(ContextOptions{.backend = GlBackend::OSMesa});
   printInfo(context);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/gaussian_filter.h"
 
 namespace eik {
 
@@ -87,6 +88,10 @@ void applyBake(Volume& volume, const BakeResult& result, const LightSpec& light)
   volume.fields["light_dir"] = result.light_dir;
   volume.metadata["light"] = light.toJson();
   volume.metadata["bake_stats"] = result.stats.toJson();
+}
+
+void smoothIrradiance(BakeResult& result, const GridSpec& grid, double sigma_voxels) {
+  gaussianSmoothComponents(result.irradiance, grid, sigma_voxels);
 }
 
 LightSpec parseLight(const std::string& light_text, const std::string& power_text) {

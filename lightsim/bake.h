@@ -15,6 +15,12 @@ namespace eik {
 // volume's grid (3 components, one per voxel).
 void applyBake(Volume& volume, const BakeResult& result, const LightSpec& light);
 
+// Filters the bake's irradiance with a normalised 3D Gaussian of σ voxels (core/gaussian_filter.h),
+// a reconstruction filter for the deposits at patch midpoints. It keeps the sum of the irradiance
+// except within 3σ of the grid's faces (the borders clamp), and leaves the light direction as it is.
+// σ = 0 does nothing.
+void smoothIrradiance(BakeResult& result, const GridSpec& grid, double sigma_voxels);
+
 // Parses `--light` ("directional:DX,DY,DZ" or "point:X,Y,Z") and `--power` ("R,G,B", or one value
 // for all three channels). The direction is normalised. Throws InputError naming --light or
 // --power for malformed text, a non-finite number, a zero direction, a negative channel or a power

@@ -56,6 +56,7 @@ int run(int argc, char** argv) {
                                          gl_backend = "auto";
   SimulationOptions options;
   int bench_runs = 0;
+  double smooth_irradiance = 0.0;
   bool quiet = false, raw = false;
   CLI::App app{
       "lightsim: propagate a light's wavefront through a volume as a GPU particle system of adaptive\n"
@@ -69,8 +70,10 @@ int run(int argc, char** argv) {
                  "R,G,B: irradiance in W/m² of a directional light, radiant intensity in W/sr of a point light "
                  "(default 1,1,1)");
   app.add_option("--scene", scene_path, "take the light from this SCENE.json (its first light) instead of --light");
-  app.add_option("--backend", backend, "gl (the GPU particle system, default) or cpu (the CPU twin)")
-      ->check(CLI::IsMember({"gl", "cpu"}));
+  app.add_option("--backend", backend,
+                 "gl (the GPU particle system, default), cpu (the CPU twin) or auto (gl on a hardware GPU, cpu "
+                 "when OpenGL is a software rasterizer such as llvmpipe, where the twin is faster)")
+      ->check(CLI::IsMember({"gl", "cpu", "auto"}));
   app.add_option("--deposit", deposit,
                  "accumulate (default: sums every wavefront sheet, conserves energy) or max (the thesis: the "
                  "strongest patch per voxel)")
@@ -91,6 +94,10 @@ int run(int argc, char** argv) {
                  "keep (default: a patch that should split beyond --max-depth goes on unsplit while its edges stay "
                  "within 4 split lengths, then dies) or kill (the thesis: it dies at once)")
       ->check(CLI::IsMember({"keep", "kill"}));
+  app.add_option("--smooth-irradiance", smooth_irradiance,
+                 "sigma in voxels of a Gaussian reconstruction filter on the baked irradiance: it removes "
+                 "the voxel-scale grain of midpoint deposits, at the cost of that much blur (default 0: none)")
+      ->check(CLI::Range(0.0, 4.0));
   app.add_option("--max-steps", options.max_steps, "step limit (default: 4 grid diagonals)")->check(CLI::Range(0, 1000000));
   app.add_option("--flux-threshold", options.flux_threshold,
                  "kill patches below this fraction of the initial patch flux (default 1e-4)")
@@ -129,6 +136,23 @@ int run(int argc, char** argv) {
   volume.require("ior", 1, input);
   volume.require("ior_grad", 3, input);
 
+  // --backend auto: probe the OpenGL renderer; a hardware context stays alive for the GPU path.
+  std::unique_ptr<gl::GlContext> probe;
+  if (backend == "auto") {
+    backend = "cpu";
+    try {
+      gl::ContextOptions context;
+      context.backend = gl::parseGlBackend(gl_backend);
+      probe = std::make_unique<gl::GlContext>(context);
+      if (!gl::isSoftwareRenderer(probe->info())) backend = "gl";
+      if (!quiet)
+        std::fprintf(stderr, "lightsim: --backend auto: %s, so the %s\n", probe->info().renderer.c_str(),
+                     backend == "gl" ? "GPU path" : "CPU twin (faster than a software rasterizer)");
+    } catch (const std::exception& e) {
+      if (!quiet) std::fprintf(stderr, "lightsim: --backend auto: no OpenGL context (%s), so the CPU twin\n", e.what());
+    }
+    if (backend == "cpu") probe.reset();
+  }
   std::unique_ptr<Simulator> simulator;
   if (backend == "cpu") {
     simulator = std::make_unique<CpuSimulator>(volume);
@@ -180,7 +204,9 @@ int run(int argc, char** argv) {
   if (lightMissedVolume(result.stats))
     std::fprintf(stderr, "lightsim: warning: the light misses the volume; the bake is empty\n");
 
+  if (smooth_irradiance > 0.0) smoothIrradiance(result, volume.grid, smooth_irradiance);
   applyBake(volume, result, light);
+  if (smooth_irradiance > 0.0) volume.metadata["irradiance_smoothing_sigma_voxels"] = smooth_irradiance;
   VolumeWriteOptions write;
   write.gzip = !raw;
   writeVolume(volume, output, write);

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs what Eikonal needs from Debian 12's packages. Idempotent: does nothing (quickly) when
-# everything is already there.
+# Installs what Eikonal needs from Debian 12's packages, then prepares the scenes' third-party data
+# (scripts/fetch_assets.sh: HDRIs from blender-data, the bunny from npm). Idempotent: does nothing
+# (quickly) when everything is already there.
 set -euo pipefail
 
 packages=(
@@ -11,22 +12,25 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libimgui-dev
   xvfb xauth
+  blender-data
 )
+# npm fetches the Stanford bunny (npm package "bunny"); Debian's npm brings Node.js with it.
+command -v npm >/dev/null 2>&1 || packages+=(npm)
 
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 
-if [ ${#missing[@]} -eq 0 ]; then
-  exit 0
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then
+    SUDO="sudo"
+  fi
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-echo "setup: installing ${missing[*]}"
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then
-  SUDO="sudo"
-fi
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+"$(dirname "$0")/fetch_assets.sh"

@@ -118,7 +118,7 @@ Environment::Environment(const SceneEnvironmentSpec& spec, const std::filesystem
     kind_ = EnvironmentKind::Checker;
     colour_ = glm::vec3(spec.uniform.value_or(glm::dvec3(1.0)));
   } else if (!spec.procedural.empty()) {
-    throw InputError(source, "environment.procedural", "'" + spec.procedural + "' is not known; expected \"sky\"");
+    throw InputError(source, "environment.procedural", "'" + spec.procedural + "' is not known; expected \"sky\" or \"checker\"");
   } else {
     kind_ = EnvironmentKind::Uniform;
     colour_ = glm::vec3(spec.uniform.value_or(glm::dvec3(0.0)));

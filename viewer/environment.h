@@ -7,7 +7,7 @@
 //                that diverged through glass look it up at a coarser level (footprint LOD)
 //   sky          {"procedural": "sky"}: an analytic daylight sky, brighter towards the horizon and
 //                the sun (the scene's first directional light), over a dim ground-coloured lower half
-//   checker      {"procedural": "checker", "uniform": [r, g, b]} (only from --env checker:R,G,B):
+//   checker      {"procedural": "checker"} or --env checker:R,G,B:
 //                24 × 12 latitude/longitude cells, bright ones `uniform`, dark ones 0.2 of it
 // `intensity` scales every kind; `rotate_deg` turns it about the world up (+y) axis.
 // GLSL side: shaders/viewer/environment.glsl (variant by #define ENV_UNIFORM / ENV_MAP / ENV_SKY /

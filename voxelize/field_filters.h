@@ -2,6 +2,7 @@
 // n and ∇n the ray equation needs (thesis §3.1).
 #pragma once
 
+#include "core/gaussian_filter.h"
 #include "core/grid.h"
 #include "core/volume.h"
 
@@ -10,16 +11,7 @@ namespace eik {
 // Default standard deviation of the pre-smoothing kernel, in voxels (thesis §3.1: 0.5–1).
 constexpr double kDefaultSmoothSigmaVoxels = 0.75;
 
-// Radius in voxels of the discrete Gaussian kernel: ceil(3σ) (0 for σ = 0).
-int gaussianRadius(double sigma_voxels);
-
-// Separable 3D Gaussian convolution of a 1-component field, in place (thesis Eq. 3.2).
-// σ is the standard deviation in voxels along every axis; the discrete kernel
-// w_k ∝ exp(−k²/(2σ²)), |k| ≤ ceil(3σ), is normalised to sum 1, so constants and (away from the
-// borders) linear ramps and the field's sum are preserved. Borders clamp to the edge voxel, so a
-// grid surrounded by air stays air. σ = 0 does nothing. Throws std::invalid_argument for σ < 0,
-// a field that is not 1-component or whose size does not match the grid.
-void gaussianSmooth(Field& scalar, const GridSpec& grid, double sigma_voxels);
+// gaussianRadius and gaussianSmooth (Eq. 3.2) live in core/gaussian_filter.h.
 
 // ∇f of a 1-component field by central differences (thesis Eq. 3.1), in 1/world-unit:
 // (f(i+1) − f(i−1)) / 2h per axis, one-sided (f(1) − f(0)) / h at the borders, 0 along an axis
