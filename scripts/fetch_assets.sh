@@ -9,6 +9,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 env_dir="$root/assets/env"
 mesh_dir="$root/assets/meshes"
+mkdir -p "$env_dir" "$mesh_dir"
 world=/usr/share/blender/datafiles/studiolights/world
 
 for name in courtyard studio sunset interior forest night city sunrise; do
@@ -28,8 +29,12 @@ if [ ! -s "$bunny" ]; then
   tmp=$(mktemp -d)
   trap 'rm -rf "$tmp"' EXIT
   echo "fetch_assets: fetching the Stanford bunny from npm (package bunny@1.0.1)"
-  npm install --no-save --no-audit --no-fund --loglevel=error --prefix "$tmp" bunny@1.0.1 >/dev/null
-  node "$root/scripts/bunny_to_obj.js" "$tmp/node_modules/bunny" "$bunny.tmp"
-  mv "$bunny.tmp" "$bunny"
-  echo "fetch_assets: wrote $bunny"
+  if npm install --no-save --no-audit --no-fund --loglevel=error --prefix "$tmp" bunny@1.0.1 >/dev/null &&
+     node "$root/scripts/bunny_to_obj.js" "$tmp/node_modules/bunny" "$bunny.tmp"; then
+    mv "$bunny.tmp" "$bunny"
+    echo "fetch_assets: wrote $bunny"
+  else
+    rm -f "$bunny.tmp"
+    echo "fetch_assets: warning: could not fetch the bunny from npm; the amber_bunny scene needs it" >&2
+  fi
 fi

@@ -53,8 +53,12 @@ for program in voxelize/voxelize lightsim/lightsim viewer/viewer; do
     exit 2
   fi
 done
-if [ ! -s "$assets/env/studio.exr" ] || [ ! -s "$assets/meshes/bunny.obj" ]; then
-  echo "scene.sh: the environment maps or the bunny are missing; run bash scripts/fetch_assets.sh" >&2
+if [ ! -s "$assets/env/studio.exr" ]; then
+  echo "scene.sh: the environment maps in assets/env/ are missing; run bash scripts/fetch_assets.sh" >&2
+  exit 2
+fi
+if [[ " ${names[*]} " == *" amber_bunny "* ]] && [ ! -s "$assets/meshes/bunny.obj" ]; then
+  echo "scene.sh: assets/meshes/bunny.obj is missing; run bash scripts/fetch_assets.sh (it needs npm)" >&2
   exit 2
 fi
 
@@ -88,17 +92,19 @@ for name in "${names[@]}"; do
   echo "scene.sh: [$i/${#names[@]}] $name: voxelize and bake into $dir"
   rm -f "$dir/.times"
   (cd "$dir" && ASSETS=$assets SCENE_DIR=$assets/$name && source "$assets/$name/build.sh")
-  render_s=null image=null
+  render_s=null image=null renderer=""
   if [ "$render" = 1 ]; then
     echo "scene.sh: [$i/${#names[@]}] $name: render"
     t3=$(now)
-    "$bin/viewer/viewer" "$dir/SCENE.json" --render "$out/$name.png" ${size:+--size "$size"}
+    viewer_says=$("$bin/viewer/viewer" "$dir/SCENE.json" --render "$out/$name.png" ${size:+--size "$size"} 2>&1) ||
+      { echo "$viewer_says" >&2; exit 1; }
     render_s=$(seconds "$t3" "$(now)")
+    renderer=$(echo "$viewer_says" | sed -n 's/.* with \(.*\)$/\1/p' | tail -1)
     image="\"$name.png\""
     echo "scene.sh: wrote $out/$name.png"
   fi
-  printf '{"scene": "%s", "voxelize_s": %s, "bake_s": %s, "render_s": %s, "image": %s, "size": "%s", "backend": "%s"}\n' \
-    "$name" "$(total voxelize "$dir/.times")" "$(total bake "$dir/.times")" "$render_s" "$image" "${size:-scene}" "$backend" \
+  printf '{"scene": "%s", "voxelize_s": %s, "bake_s": %s, "render_s": %s, "image": %s, "size": "%s", "renderer": "%s"}\n' \
+    "$name" "$(total voxelize "$dir/.times")" "$(total bake "$dir/.times")" "$render_s" "$image" "${size:-scene}" "$renderer" \
     >"$dir/times.json"
   rm -f "$dir/.times"
 done

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,53 @@ TEST(LightsimCli, BakesOnBothBackends) {
     EXPECT_GT(stats["steps"].get<int>(), 0);
     EXPECT_EQ(stats["backend"], backend);
   }
+}
+
+// --backend auto takes the CPU twin on a software rasterizer (this machine's llvmpipe) and says so.
+TEST(LightsimCli, AutoBackendPicksTheTwinOnASoftwareRasterizer) {
+  TempDir dir;
+  makeSphere(dir);
+  ProgramResult r = runProgram(LIGHTSIM_EXE,
+                               {"ball.vol.json", "-o", "auto.vol.json", "--light", "directional:0,-1,0", "--backend",
+                                "auto", "--max-depth", "2", "--stats", "auto.json"},
+                               dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("--backend auto:"), std::string::npos) << r.output;
+  nlohmann::json stats = nlohmann::json::parse(readFile(dir / "auto.json"));
+  const bool software = r.output.find("llvmpipe") != std::string::npos ||
+                        r.output.find("no OpenGL context") != std::string::npos;
+  EXPECT_EQ(stats["backend"], software ? "cpu" : "gl") << r.output;
+}
+
+// --smooth-irradiance is a normalised filter: the light's total stays (the sphere sits well inside
+// its grid, so little lies near the faces), the voxel-to-voxel grain goes, and the manifest says so.
+TEST(LightsimCli, SmoothedIrradianceKeepsTheTotalAndLosesTheGrain) {
+  TempDir dir;
+  makeSphere(dir);
+  for (const char* sigma : {"0", "1"}) {
+    ProgramResult r = runProgram(LIGHTSIM_EXE,
+                                 {"ball.vol.json", "-o", std::string("s") + sigma + ".vol.json", "--light",
+                                  "directional:0.3,-1,0.2", "--backend", "cpu", "--smooth-irradiance", sigma, "--quiet"},
+                                 dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  const Volume raw = readVolume(dir / "s0.vol.json"), smooth = readVolume(dir / "s1.vol.json");
+  EXPECT_FALSE(raw.metadata.contains("irradiance_smoothing_sigma_voxels"));
+  EXPECT_EQ(smooth.metadata["irradiance_smoothing_sigma_voxels"], 1.0);
+  const GridSpec& g = raw.grid;
+  double total_raw = 0.0, total_smooth = 0.0, grain_raw = 0.0, grain_smooth = 0.0;
+  for (int z = 0; z < g.dims.z; ++z)
+    for (int y = 0; y < g.dims.y; ++y)
+      for (int x = 0; x + 1 < g.dims.x; ++x) {
+        const float* a = raw.fields.at("irradiance").voxel(g.index(x, y, z));
+        const float* b = smooth.fields.at("irradiance").voxel(g.index(x, y, z));
+        total_raw += a[1];
+        total_smooth += b[1];
+        grain_raw += std::abs(raw.fields.at("irradiance").voxel(g.index(x + 1, y, z))[1] - a[1]);
+        grain_smooth += std::abs(smooth.fields.at("irradiance").voxel(g.index(x + 1, y, z))[1] - b[1]);
+      }
+  EXPECT_NEAR(total_smooth, total_raw, 0.03 * total_raw);
+  EXPECT_LT(grain_smooth, 0.7 * grain_raw);
 }
 
 TEST(LightsimCli, BenchRepeatsTheBakeAndReportsItsFigures) {
