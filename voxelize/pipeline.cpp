@@ -14,7 +14,12 @@ Volume buildVolume(const std::vector<Region>& regions, const GridSpec& grid, con
   Volume volume = compositeRegions(regions, grid, composite);
 
   Field& ior = volume.fields.at("ior");
-  gaussianSmooth(ior, grid, options.smooth_sigma_voxels);  // Eq. 3.2: only n is smoothed
+  gaussianSmooth(ior, grid, options.smooth_sigma_voxels);  // Eq. 3.2
+  // n(λ) = n + B·(1/λ² − 1/λ_d²): the Cauchy B is part of n, so it is smoothed with it. Then
+  // B/(n − 1) stays the material's own ratio through the boundary layer, which the viewer's
+  // ∇n(λ) = ∇n·(1 + c·B/(n − 1)) relies on.
+  if (auto dispersion = volume.fields.find("dispersion"); dispersion != volume.fields.end())
+    gaussianSmooth(dispersion->second, grid, options.smooth_sigma_voxels);
   if (options.progress) options.progress(0.8);
   volume.fields["ior_grad"] = gradient(ior, grid, options.gradient);  // Eq. 3.1
   volume.metadata["ior_smoothing_sigma_voxels"] = options.smooth_sigma_voxels;

@@ -23,8 +23,9 @@ struct PipelineOptions {
 
 // compositeRegions → gaussianSmooth(ior, σ) → ior_grad = gradient(ior) (Eq. 3.1; by default with
 // the isotropic cross-average, see field_filters.h).
-// Only n is smoothed, as in the thesis: σa, emission, scatter and opaque keep their sharp
-// box-filtered boundaries (they enter the image linearly, so blocky edges do not bend rays).
+// Only n (and the Cauchy B of `dispersion`, which is part of n(λ)) is smoothed, as in the thesis:
+// σa, emission, scatter and opaque keep their sharp box-filtered boundaries (they enter the image
+// linearly, so blocky edges do not bend rays).
 // metadata["ior_smoothing_sigma_voxels"] records σ, metadata["ior_gradient"] the operator.
 Volume buildVolume(const std::vector<Region>& regions, const GridSpec& grid, const PipelineOptions& options = {});
 

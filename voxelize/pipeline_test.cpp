@@ -273,6 +273,28 @@ TEST(Pipeline, NoSmoothingKeepsTheRawComposite) {
   EXPECT_NE(s.fields.at("ior").data, v.fields.at("ior").data);
 }
 
+// The Cauchy B is smoothed with n, so in one material B/(n − 1) is the material's ratio in every
+// voxel of the boundary layer, as the viewer's ∇n(λ) = ∇n·(1 + c·B/(n − 1)) assumes. Left sharp,
+// the outer half of the layer would have B = 0 and the inner half too much.
+TEST(Pipeline, DispersionIsSmoothedWithTheIndex) {
+  const ProceduralSpec spec = parseProceduralSpec("procedural:sphere,r=0.4,ior=1.75,abbe=20");
+  const GridSpec grid = makeGrid(proceduralBounds(spec), 32, 3.0);
+  const Volume v = buildVolume(voxelizeProcedural(spec, grid), grid);
+  const Field& n = v.fields.at("ior");
+  const Field& b = v.fields.at("dispersion");
+  const double ratio = 0.523655 / 20.0;  // B = 0.523655·(n_d − 1)/V_d
+  int layer = 0;
+  for (std::size_t i = 0; i < grid.count(); ++i) {
+    if (n.data[i] - 1.0f < 1e-3f) {
+      EXPECT_LE(b.data[i], 1.01e-3 * ratio);
+      continue;
+    }
+    if (n.data[i] < 1.74f) ++layer;
+    ASSERT_NEAR(b.data[i] / (n.data[i] - 1.0f), ratio, 1e-3 * ratio) << "voxel " << i;
+  }
+  EXPECT_GT(layer, 1000);  // the boundary layer was checked, not only the core
+}
+
 TEST(Pipeline, ReportsProgressUpToOne) {
   const ProceduralSpec spec = parseProceduralSpec("procedural:sphere");
   const GridSpec grid = makeGrid(proceduralBounds(spec), 16, 2.0);
