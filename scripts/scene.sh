@@ -9,8 +9,8 @@
 # DIR: build/scenes): SCENE.json is copied there, the volumes are written beside it, the
 # environment maps are copied to DIR/env/, and the render goes to DIR/NAME.png. Afterwards
 #   build/viewer/viewer DIR/NAME/SCENE.json
-# opens the scene in a window. DIR/NAME/times.json records the resolution and the voxelize, bake
-# and render times.
+# opens the scene in a window. DIR/NAME/times.json records the image size, the renderer and the
+# voxelize, bake and render times.
 #   --scale F     multiplies every resolution in the build.sh files (default 1)
 #   --res N       uses N voxels along the longest axis for every volume instead (tests use 24)
 #   --size WxH    image size (default: the scene's render.size)
@@ -23,15 +23,19 @@ names=()
 
 all_scenes() { for d in "$assets"/*/; do [ -f "$d/SCENE.json" ] && basename "$d"; done; }
 
+value() {  # value OPTION ARGS...: the option's argument, or a usage error
+  [ $# -ge 2 ] && [ -n "$2" ] || { echo "scene.sh: $1 needs a value (see --help)" >&2; exit 2; }
+  echo "$2"
+}
 while [ $# -gt 0 ]; do
   case "$1" in
-    --out) out=$2; shift 2 ;;
-    --scale) scale=$2; shift 2 ;;
-    --res) res_override=$2; shift 2 ;;
-    --size) size=$2; shift 2 ;;
-    --backend) backend=$2; shift 2 ;;
+    --out) out=$(value "$@"); shift 2 ;;
+    --scale) scale=$(value "$@"); shift 2 ;;
+    --res) res_override=$(value "$@"); shift 2 ;;
+    --size) size=$(value "$@"); shift 2 ;;
+    --backend) backend=$(value "$@"); shift 2 ;;
     --no-render) render=0; shift ;;
-    --build) bin=$2; shift 2 ;;
+    --build) bin=$(value "$@"); shift 2 ;;
     --quiet) quiet=--quiet; shift ;;
     --list) all_scenes; exit 0 ;;
     -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
