@@ -12,7 +12,7 @@ pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)
 # Dear ImGui 1.86 (libimgui-dev): libimgui.a holds the core and the back ends, imgui_impl_glfw and
 # imgui_impl_opengl3 included (the latter loads GL itself from libGL.so.1); headers under imgui/.
 pkg_check_modules(IMGUI REQUIRED IMPORTED_TARGET imgui>=1.86)
-# OpenImageIO through pkg-config: its CMake config names a non-existent /usr/include/opencv4 (DESIGN §3).
+# OpenImageIO through pkg-config: its CMake config names a non-existent /usr/include/opencv4 (docs/architecture.md).
 pkg_check_modules(OIIO REQUIRED IMPORTED_TARGET OpenImageIO)
 if(EIKONAL_BUILD_TESTS)
   find_package(GTest REQUIRED)

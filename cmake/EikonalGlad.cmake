@@ -1,10 +1,10 @@
-# The OpenGL function loader, generated at build time by glad 2 (python3-glad, DESIGN §3).
+# The OpenGL function loader, generated at build time by glad 2 (python3-glad, docs/architecture.md).
 #
 # eikonal_add_glad(TARGET) generates include/glad/gl.h and src/gl.c for OpenGL 3.3 core plus a few
 # extensions into the build tree and compiles them into the static library TARGET (C, no project
 # warnings: generated code is not ours). The loader is initialised at run time with the current
 # context's own getProcAddress (OSMesa, EGL or GLFW), so one binary serves every kind of context;
-# nothing ever links libGL or calls a gl* symbol directly (DESIGN §3, "known traps").
+# nothing ever links libGL or calls a gl* symbol directly (docs/architecture.md, "known traps").
 #
 # `--reproducible` is mandatory: without it glad tries to download the Khronos registry and fails
 # offline.

@@ -8,17 +8,16 @@ function(eikonal_warnings target)
   endif()
 endfunction()
 
-# One test executable per folder: every NAME_test.cpp in DIR, linked against LIBS.
-function(eikonal_add_tests name dir)
+# eikonal_add_tests(NAME SOURCES a_test.cpp ... [SUPPORT helper.cpp ...] LIBS lib ...): one gtest
+# executable per folder, from the tests listed (x_test.cpp beside x.cpp) and any test-only support
+# sources, which thereby stay out of the product libraries.
+function(eikonal_add_tests name)
   if(NOT EIKONAL_BUILD_TESTS)
     return()
   endif()
-  file(GLOB test_sources CONFIGURE_DEPENDS ${dir}/*_test.cpp)
-  if(NOT test_sources)
-    return()
-  endif()
-  add_executable(${name} ${test_sources})
-  target_link_libraries(${name} PRIVATE ${ARGN} GTest::gtest GTest::gtest_main)
+  cmake_parse_arguments(ARG "" "" "SOURCES;SUPPORT;LIBS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES} ${ARG_SUPPORT})
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gtest_main)
   eikonal_warnings(${name})
   target_compile_definitions(${name} PRIVATE EIKONAL_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
                                               EIKONAL_BINARY_DIR="${PROJECT_BINARY_DIR}")

@@ -1,5 +1,5 @@
 # Embeds every file under shaders/ into the binary, so an installed program runs from any directory
-# (DESIGN §2). gl/shader_library.cpp looks files up on disk first and falls back to this copy.
+# (docs/architecture.md). gl/shader_library.cpp looks files up on disk first and falls back to this copy.
 #
 # Two modes in one file:
 #  * included from a CMakeLists.txt: eikonal_embed_shaders(TARGET SHADER_DIR) adds a generated .cpp

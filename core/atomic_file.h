@@ -1,4 +1,4 @@
-// Atomic file output (DESIGN §4.1: "Writing is atomic ... an interrupted run never leaves a
+// Atomic file output (docs/volume-format.md: "Writing is atomic ... an interrupted run never leaves a
 // half-written volume behind"). Every file is first written under a hidden temporary name in its
 // target's directory (`.NAME.tmp-<pid>-<random>`), then renamed into place; rename(2) within one
 // directory replaces the target in one step, so readers see the old file or the new, never a part.

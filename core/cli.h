@@ -1,5 +1,5 @@
 // Command-line parsing shared by the programs (CLI11, header-only; link CLI11::CLI11).
-// DESIGN §4.2: --help exits 0, bad usage exits 2 with a message that names the flag.
+// docs/programs.md: --help exits 0, bad usage exits 2 with a message that names the flag.
 #pragma once
 
 #include <cstdio>

@@ -1,4 +1,4 @@
-// Errors shared by every program, and the exit codes they map to (DESIGN §4.2):
+// Errors shared by every program, and the exit codes they map to (docs/programs.md):
 // 0 success, 1 runtime failure, 2 bad usage or bad input.
 #pragma once
 

@@ -1,6 +1,6 @@
 // A regular, cell-centred voxel grid in world space.
 // Voxel (i,j,k) covers [min + (i,j,k)·h, min + (i+1,j+1,k+1)·h]; its sample sits at the centre
-// min + (i+0.5, j+0.5, k+0.5)·h. Data arrays are x fastest, then y, then z (DESIGN §4.1).
+// min + (i+0.5, j+0.5, k+0.5)·h. Data arrays are x fastest, then y, then z (docs/volume-format.md).
 #pragma once
 
 #include <cstddef>

@@ -1,5 +1,5 @@
 // Resource limits checked before a volume is allocated, so that a malformed or hostile header
-// fails with a clear InputError (exit 2, DESIGN §4.2) instead of an out-of-memory crash.
+// fails with a clear InputError (exit 2, docs/programs.md) instead of an out-of-memory crash.
 #pragma once
 
 #include <cstdint>

@@ -1,5 +1,5 @@
 // NRRD ("Nearly Raw Raster Data", teem format spec https://teem.sourceforge.net/nrrd/format.html)
-// reader and writer for the field files of a volume (DESIGN §4.1).
+// reader and writer for the field files of a volume (docs/volume-format.md).
 //
 // Scope: float32 samples on a 3D grid with 1–4 interleaved components (the component axis first,
 // x fastest, then y, then z). Written as NRRD0004 with `space: right-anterior-superior` (our world

@@ -21,6 +21,7 @@ namespace eik {
 namespace {
 namespace fs = std::filesystem;
 
+using test_support::inputErrorOf;
 using test_support::readFile;
 using test_support::TempDir;
 using test_support::writeFile;
@@ -50,24 +51,6 @@ std::vector<float> ramp(std::size_t count, float scale = 0.25f) {
   for (std::size_t i = 0; i < count; ++i) values[i] = static_cast<float>(i) * scale - 3.0f;
   return values;
 }
-
-// The message of the InputError `body` throws ("" and a test failure if it throws nothing or something else).
-template <typename Body>
-std::string inputErrorOf(Body&& body) {
-  try {
-    body();
-  } catch (const InputError& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected InputError, got: " << e.what();
-    return "";
-  }
-  ADD_FAILURE() << "expected InputError, nothing was thrown";
-  return "";
-}
-
-#define EXPECT_CONTAINS(text, part) \
-  EXPECT_NE(std::string(text).find(part), std::string::npos) << "message: " << (text) << "\nlacks: " << (part)
 
 // A 2×3×4 scalar volume, attached raw, with the given header lines (after the magic).
 const std::string kScalarHeader =
@@ -275,7 +258,7 @@ TEST(Nrrd, HeaderOnlyReadDoesNotTouchTheData) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Malformed input: every case names the file and the field (DESIGN §4.2).
+// Malformed input: every case names the file and the field (docs/programs.md).
 
 TEST(NrrdMalformed, WrongMagic) {
   TempDir dir;

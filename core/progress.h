@@ -1,4 +1,4 @@
-// Progress bar with ETA on a terminal (stderr), silent otherwise or with --quiet (DESIGN §4.2).
+// Progress bar with ETA on a terminal (stderr), silent otherwise or with --quiet (docs/programs.md).
 #pragma once
 
 #include <atomic>

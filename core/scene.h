@@ -1,5 +1,5 @@
 // SCENE.json: volumes placed in a world, with lights, camera, environment, ground and render
-// settings (DESIGN §4.3). Read strictly: wrong types and unknown keys are InputErrors (exit 2).
+// settings (docs/scene-format.md). Read strictly: wrong types and unknown keys are InputErrors (exit 2).
 #pragma once
 
 #include <filesystem>

@@ -1,4 +1,4 @@
-// Volumes on disk (DESIGN §4.1): a JSON manifest `NAME.vol.json` and one NRRD per field beside it,
+// Volumes on disk (docs/volume-format.md): a JSON manifest `NAME.vol.json` and one NRRD per field beside it,
 // `NAME.FIELD.nrrd` (or `NAME.FIELD.nhdr` + `NAME.FIELD.raw.gz` when detached), written atomically.
 #include "core/volume.h"
 
@@ -247,7 +247,7 @@ class ManifestReader {
       if (known != 0 && declared != known) {
         throw InputError(name_, key + ".components",
                          std::to_string(declared) + ", but the '" + name + "' field has " + std::to_string(known) +
-                             " components (DESIGN section 4.1)");
+                             " components (docs/volume-format.md)");
       }
     }
 
@@ -266,7 +266,7 @@ class ManifestReader {
     if (known != 0 && header.components != known) {
       throw InputError(name_, key,
                        nrrd + " has " + std::to_string(header.components) + " components, but the '" + name +
-                           "' field has " + std::to_string(known) + " (DESIGN section 4.1)");
+                           "' field has " + std::to_string(known) + " (docs/volume-format.md)");
     }
     if (header.sizes != grid.dims) {
       throw InputError(name_, key,
@@ -343,7 +343,7 @@ Field& Volume::addField(const std::string& name, int components) {
   int known = knownFieldComponents(name);
   if (known != 0 && known != components) {
     throw RuntimeError("fields." + name + ": " + std::to_string(components) + " components, but the '" + name +
-                       "' field has " + std::to_string(known) + " (DESIGN section 4.1)");
+                       "' field has " + std::to_string(known) + " (docs/volume-format.md)");
   }
   Field& field = fields[name];
   field.components = components;
@@ -407,7 +407,7 @@ void writeVolume(const Volume& volume, const fs::path& manifest, const VolumeWri
     if (known != 0 && known != field.components) {
       throw RuntimeError(name + ": fields." + field_name + ": " + std::to_string(field.components) +
                          " components, but the '" + field_name + "' field has " + std::to_string(known) +
-                         " (DESIGN section 4.1)");
+                         " (docs/volume-format.md)");
     }
     fs::path file = dir / (stem + "." + field_name + (options.detached ? ".nhdr" : ".nrrd"));
     stageNrrd(files, file, nrrdHeaderFor(grid, field.components), field.data, {options.gzip, options.detached});

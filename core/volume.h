@@ -1,5 +1,5 @@
 // A material volume: named float fields on one grid, stored on disk as a JSON manifest
-// (`*.vol.json`) naming one NRRD file per field (DESIGN §4.1, thesis §6.1 textures T1–T8).
+// (`*.vol.json`) naming one NRRD file per field (docs/volume-format.md, thesis §6.1 textures T1–T8).
 #pragma once
 
 #include <cstddef>
@@ -15,7 +15,7 @@
 
 namespace eik {
 
-// The fields DESIGN §4.1 defines, with their component counts. Other names are allowed
+// The fields docs/volume-format.md defines, with their component counts. Other names are allowed
 // (written and read like any field) but programs only interpret these.
 struct FieldSpec {
   std::string_view name;
@@ -58,7 +58,7 @@ struct VolumeWriteOptions {
 };
 
 // Reads a manifest and every field it names. Throws InputError (exit 2) naming the file and the
-// field for anything malformed (DESIGN §4.1, issue "Foundation" §3).
+// field for anything malformed (docs/volume-format.md, issue "Foundation" §3).
 Volume readVolume(const std::filesystem::path& manifest);
 // Reads only the manifest and the headers (grid, field table); no voxel data.
 Volume readVolumeHeader(const std::filesystem::path& manifest);

@@ -18,26 +18,10 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+using test_support::inputErrorOf;
 using test_support::readFile;
 using test_support::TempDir;
 using test_support::writeFile;
-
-template <typename Body>
-std::string inputErrorOf(Body&& body) {
-  try {
-    body();
-  } catch (const InputError& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected InputError, got: " << e.what();
-    return "";
-  }
-  ADD_FAILURE() << "expected InputError, nothing was thrown";
-  return "";
-}
-
-#define EXPECT_CONTAINS(text, part) \
-  EXPECT_NE(std::string(text).find(part), std::string::npos) << "message: " << (text) << "\nlacks: " << (part)
 
 Volume sampleVolume() {
   Volume volume;
@@ -351,7 +335,7 @@ TEST(VolumeMalformed, WholeVolumeOverTheMemoryLimit) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Atomic writes (DESIGN §4.1)
+// Atomic writes (docs/volume-format.md)
 
 TEST(VolumeWrite, FailureMidWriteLeavesNoFiles) {
   TempDir dir;

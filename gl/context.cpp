@@ -5,11 +5,11 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cctype>
 #include <cstdlib>
 #include <string>
 
 #include "core/error.h"
+#include "core/text.h"
 #include "gl/context_backend.h"
 #include "gl/debug.h"
 #include "gl/gl.h"
@@ -58,12 +58,11 @@ void loadFunctions(detail::GlProcLoader loader, const std::string& backendName) 
 }  // namespace
 
 GlBackend parseGlBackend(std::string_view text, std::string_view source) {
-  std::string lower(text);
-  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (lower == "auto") return GlBackend::Auto;
-  if (lower == "osmesa") return GlBackend::OSMesa;
-  if (lower == "egl") return GlBackend::EGL;
-  if (lower == "window" || lower == "glfw") return GlBackend::Window;
+  const std::string name = lower(text);
+  if (name == "auto") return GlBackend::Auto;
+  if (name == "osmesa") return GlBackend::OSMesa;
+  if (name == "egl") return GlBackend::EGL;
+  if (name == "window" || name == "glfw") return GlBackend::Window;
   throw InputError(std::string(source), "", "unknown OpenGL back end '" + std::string(text) +
                                                 "' (expected auto, osmesa, egl or window)");
 }
@@ -85,9 +84,7 @@ bool displayAvailable() {
 }
 
 bool isSoftwareRenderer(const GlInfo& info) {
-  std::string renderer = info.renderer;
-  std::transform(renderer.begin(), renderer.end(), renderer.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string renderer = lower(info.renderer);
   for (const char* name : {"llvmpipe", "softpipe", "swrast", "swiftshader"})
     if (renderer.find(name) != std::string::npos) return true;
   return false;

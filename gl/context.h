@@ -1,4 +1,4 @@
-// An OpenGL 3.3 core context (DESIGN §3): one interface, three back ends.
+// An OpenGL 3.3 core context (docs/architecture.md): one interface, three back ends.
 //   OSMesa  headless, software (llvmpipe); the default headless back end.
 //   EGL     headless without a display: EGL_EXT_platform_device (GPU servers), then
 //           EGL_MESA_platform_surfaceless, then the default display. Survives Mesa ≥ 25.1, which

@@ -1,6 +1,6 @@
 // OSMesa back end of GlContext: a headless software context (llvmpipe). It renders into a small
 // buffer of our own that only OSMesaMakeCurrent needs; real rendering goes into framebuffer objects.
-// OSMesa refuses forward-compatible contexts, so none is asked for (DESIGN §3).
+// OSMesa refuses forward-compatible contexts, so none is asked for (docs/architecture.md).
 #include <GL/osmesa.h>  // includes <GL/gl.h> for its types; no gl* function is called here
 
 #include <cstdint>

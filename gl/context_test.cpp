@@ -8,12 +8,13 @@
 #include <cstdlib>
 
 #include "gl/debug.h"
+#include "core/testing.h"
 #include "gl/test_util.h"
 
 namespace eik::gl {
 namespace {
 
-using test::ScopedEnv;
+using test_support::ScopedEnv;
 
 void printInfo(const GlContext& context) {
   std::printf("[ context  ] %s\n", context.summary().c_str());

@@ -1,6 +1,6 @@
 // GLFW back end of GlContext: an OpenGL 3.3 core context in a window (visible or hidden,
 // resizable), for the interactive viewer and for tests under Xvfb. No GLFW_OPENGL_FORWARD_COMPAT:
-// Mesa does not need it and OSMesa-style drivers refuse it (DESIGN §3).
+// Mesa does not need it and OSMesa-style drivers refuse it (docs/architecture.md).
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 

@@ -1,6 +1,6 @@
 // GlHandle: the move-only owner of one OpenGL object name, the base of every RAII type in gl/.
 //
-// Conventions for all of gl/ (no GL state leaks between passes, DESIGN §2):
+// Conventions for all of gl/ (no GL state leaks between passes, docs/architecture.md):
 //  * An object remembers the context it was made in (GlContext::serial) and deletes its name in
 //    its destructor only while that context is current; destroy objects before their context.
 //  * Methods named bind() / use() change GL bindings on purpose: they set up the next draw.

@@ -1,7 +1,7 @@
 // ShaderLibrary: finds shaders under shaders/ by relative path ("viewer/raymarch.frag"), expands
 // `#include "common/x.glsl"` (recursively, each file once, cycles reported), injects `#define`s
 // right after `#version` (llvmpipe executes branches on uniforms, so variants are built with
-// defines, DESIGN §3) and inserts `#line` directives so compiler errors name the file and line.
+// defines, docs/architecture.md) and inserts `#line` directives so compiler errors name the file and line.
 //
 // Search order for each file:
 //   1. directories given in ShaderLibraryOptions::directories (in order);

@@ -8,13 +8,15 @@
 #include <regex>
 #include <sstream>
 
+#include "core/testing.h"
 #include "gl/test_util.h"
 
 namespace eik::gl {
 namespace {
 
-using test::ScopedEnv;
-using test::TempDir;
+using test_support::ScopedEnv;
+using test_support::TempDir;
+using test_support::writeFile;
 
 ShaderLibraryOptions onlyDirectory(const std::filesystem::path& directory) {
   ShaderLibraryOptions options;
@@ -107,9 +109,9 @@ TEST(ShaderLibraryTest, RejectsBadPathsAndDefines) {
 
 TEST(ShaderLibraryTest, IncludeCycleIsReported) {
   TempDir dir;
-  dir.write("common/a.glsl", "// a\n#include \"common/b.glsl\"\n");
-  dir.write("common/b.glsl", "// b\n\n#include \"../common/a.glsl\"\n");
-  dir.write("test/main.frag", "#version 330 core\n#include \"common/a.glsl\"\nvoid main() {}\n");
+  writeFile(dir / "common/a.glsl", "// a\n#include \"common/b.glsl\"\n");
+  writeFile(dir / "common/b.glsl", "// b\n\n#include \"../common/a.glsl\"\n");
+  writeFile(dir / "test/main.frag", "#version 330 core\n#include \"common/a.glsl\"\nvoid main() {}\n");
   ShaderLibrary library(onlyDirectory(dir.path()));
   try {
     library.source("test/main.frag");
@@ -125,7 +127,7 @@ TEST(ShaderLibraryTest, IncludeCycleIsReported) {
 
 TEST(ShaderLibraryTest, MissingIncludeNamesTheIncludingLine) {
   TempDir dir;
-  dir.write("test/main.frag", "#version 330 core\n\n#include \"common/nowhere.glsl\"\n");
+  writeFile(dir / "test/main.frag", "#version 330 core\n\n#include \"common/nowhere.glsl\"\n");
   ShaderLibrary library(onlyDirectory(dir.path()));
   try {
     library.source("test/main.frag");
@@ -138,10 +140,10 @@ TEST(ShaderLibraryTest, MissingIncludeNamesTheIncludingLine) {
 
 TEST_F(ShaderLibraryGl, EachFileIsIncludedOnce) {
   TempDir dir;
-  dir.write("common/fullscreen.vert", ShaderLibrary().read("common/fullscreen.vert"));
-  dir.write("common/f.glsl", "#pragma once\nfloat f() { return 1.0; }\n");
-  dir.write("common/g.glsl", "#include \"common/f.glsl\"\nfloat g() { return f(); }\n");
-  dir.write("test/main.frag",
+  writeFile(dir / "common/fullscreen.vert", ShaderLibrary().read("common/fullscreen.vert"));
+  writeFile(dir / "common/f.glsl", "#pragma once\nfloat f() { return 1.0; }\n");
+  writeFile(dir / "common/g.glsl", "#include \"common/f.glsl\"\nfloat g() { return f(); }\n");
+  writeFile(dir / "test/main.frag",
             "#version 330 core\n#include \"common/f.glsl\"\n#include \"common/g.glsl\"\n#include \"common/f.glsl\"\n"
             "out vec4 o;\nvoid main() { o = vec4(f() + g()); }\n");
   ShaderLibrary library(onlyDirectory(dir.path()));
@@ -150,13 +152,13 @@ TEST_F(ShaderLibraryGl, EachFileIsIncludedOnce) {
 
 TEST_F(ShaderLibraryGl, CompileErrorInAnIncludedFileNamesFileAndLine) {
   TempDir dir;
-  dir.write("common/fullscreen.vert", ShaderLibrary().read("common/fullscreen.vert"));
-  dir.write("common/helpers.glsl",
+  writeFile(dir / "common/fullscreen.vert", ShaderLibrary().read("common/fullscreen.vert"));
+  writeFile(dir / "common/helpers.glsl",
             "// helpers\n"
             "float helperOk() { return 1.0; }\n"
             "\n"
             "float helperBroken() { return undefinedThing; }\n");  // line 4
-  dir.write("test/broken.frag",
+  writeFile(dir / "test/broken.frag",
             "#version 330 core\n"
             "// a comment\n"
             "#include \"common/helpers.glsl\"\n"
@@ -169,14 +171,14 @@ TEST_F(ShaderLibraryGl, CompileErrorInAnIncludedFileNamesFileAndLine) {
   EXPECT_NE(message.find("undefinedThing"), std::string::npos) << message;
 
   // An error in the main file after the include: the line count resumes correctly.
-  dir.write("test/broken2.frag",
+  writeFile(dir / "test/broken2.frag",
             "#version 330 core\n"
             "#include \"common/helpers.glsl\"\n"
             "out vec4 o;\n"
             "void main() {\n"
             "  o = vec4(nope);\n"  // line 5
             "}\n");
-  dir.write("common/helpers.glsl", "float helperOk() { return 1.0; }\n");
+  writeFile(dir / "common/helpers.glsl", "float helperOk() { return 1.0; }\n");
   message = compileError(library, "test/broken2.frag", {{"MODE", "1"}});
   EXPECT_NE(message.find("test/broken2.frag:5:"), std::string::npos) << message;
 
@@ -215,7 +217,7 @@ TEST_F(ShaderLibraryGl, EmbeddedCopyIsUsedWhenTheDirectoriesAreHidden) {
 
 TEST_F(ShaderLibraryGl, EmbeddedOnlyEnvironmentSkipsTheDisk) {
   TempDir dir;
-  dir.write("test/pattern.frag", "this is not GLSL");
+  writeFile(dir / "test/pattern.frag", "this is not GLSL");
   ScopedEnv shaderDir("EIKONAL_SHADER_DIR", dir.path().c_str());
   {
     ShaderLibrary library;  // EIKONAL_SHADER_DIR first: the broken override wins

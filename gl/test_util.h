@@ -1,4 +1,5 @@
-// Helpers shared by the gl/ tests (header only; not part of eikonal_gl).
+// Helpers shared by the gl/ tests (header only; not part of eikonal_gl): a test pattern and its
+// check. Temporary directories and environment variables: core/testing.h.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -18,60 +19,6 @@
 #include "gl/vertex_array.h"
 
 namespace eik::gl::test {
-
-// Sets an environment variable for a scope, restoring the previous value.
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const char* value) : name_(name) {
-    if (const char* old = std::getenv(name)) previous_ = old, hadPrevious_ = true;
-    if (value) {
-      ::setenv(name, value, 1);
-    } else {
-      ::unsetenv(name);
-    }
-  }
-  ~ScopedEnv() {
-    if (hadPrevious_) {
-      ::setenv(name_.c_str(), previous_.c_str(), 1);
-    } else {
-      ::unsetenv(name_.c_str());
-    }
-  }
-  ScopedEnv(const ScopedEnv&) = delete;
-  ScopedEnv& operator=(const ScopedEnv&) = delete;
-
- private:
-  std::string name_;
-  std::string previous_;
-  bool hadPrevious_ = false;
-};
-
-// A fresh, empty temporary directory, removed with the object.
-class TempDir {
- public:
-  TempDir() {
-    std::random_device random;
-    path_ = std::filesystem::temp_directory_path() /
-            ("eikonal-gl-test-" + std::to_string(::getpid()) + "-" + std::to_string(random()));
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code error;
-    std::filesystem::remove_all(path_, error);
-  }
-  const std::filesystem::path& path() const { return path_; }
-  void write(const std::string& relative, const std::string& text) const {
-    std::filesystem::path file = path_ / relative;
-    std::filesystem::create_directories(file.parent_path());
-    FILE* f = std::fopen(file.c_str(), "wb");
-    ASSERT_NE(f, nullptr);
-    std::fwrite(text.data(), 1, text.size(), f);
-    std::fclose(f);
-  }
-
- private:
-  std::filesystem::path path_;
-};
 
 // The expected value of shaders/test/pattern.frag (MODE 2) at pixel (x, y) of a w × h target.
 inline void expectedPattern(int x, int y, int w, int h, float cell, float out[4]) {

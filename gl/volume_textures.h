@@ -1,6 +1,6 @@
-// Volume upload: the fields of an eik::Volume (DESIGN §4.1) packed into as few 3D float textures
+// Volume upload: the fields of an eik::Volume (docs/volume-format.md) packed into as few 3D float textures
 // as a fixed, co-sampling-friendly grouping allows, and the layout as GLSL #defines so shaders are
-// specialised per volume (no uniform branches, DESIGN §3). The grouping (thesis §6.1 T1–T8):
+// specialised per volume (no uniform branches, docs/architecture.md). The grouping (thesis §6.1 T1–T8):
 //
 //   texture     channels                         sampled together when
 //   optics      ior (r), ior_grad (gba)          every ray step (Eq. 5.11/5.12)
@@ -16,7 +16,7 @@
 // fields present take consecutive channels in the order above (ior_grad alone is rgb). Each
 // texture gets the float format of its channel count (R32F ... RGBA32F; 16-bit with `half`; RGBA
 // always with `padToRGBA`).
-// Fields that DESIGN §4.1 does not define are not uploaded (listed in ignored()).
+// Fields that docs/volume-format.md does not define are not uploaded (listed in ignored()).
 // Texture coordinates: voxel (i,j,k) is sampled at ((i,j,k) + 0.5) / dims, x fastest.
 #pragma once
 

@@ -6,6 +6,7 @@
 
 #include <random>
 
+#include "core/testing.h"
 #include "gl/test_util.h"
 
 namespace eik::gl {
@@ -208,7 +209,7 @@ TEST_F(VolumeTexturesGl, OverBudgetVolumeNamesSizeAndBudget) {
     EXPECT_NE(message.find("8x8x8"), std::string::npos) << message;
     EXPECT_NE(message.find("budget"), std::string::npos) << message;
   }
-  test::ScopedEnv env("EIKONAL_GL_TEXTURE_BUDGET_MB", "1");
+  test_support::ScopedEnv env("EIKONAL_GL_TEXTURE_BUDGET_MB", "1");
   EXPECT_EQ(defaultTextureBudget(), std::size_t(1) << 20);
   EXPECT_NO_THROW(VolumeTextures(volume, VolumeTextureOptions{}));
 }

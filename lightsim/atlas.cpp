@@ -1,4 +1,4 @@
-// Flat 3D atlas targets and the deposit pass (see atlas.h).
+// Flat 3D atlas layout and targets (see atlas.h).
 #include "lightsim/atlas.h"
 
 #include <algorithm>
@@ -18,47 +18,6 @@ std::string dimsText(glm::ivec3 d) {
 }
 
 }  // namespace
-
-ScopedBlendAdd::ScopedBlendAdd() {
-  enabled_ = glIsEnabled(GL_BLEND);
-  glGetIntegerv(GL_BLEND_EQUATION_RGB, &equationRgb_);
-  glGetIntegerv(GL_BLEND_EQUATION_ALPHA, &equationAlpha_);
-  glGetIntegerv(GL_BLEND_SRC_RGB, &srcRgb_);
-  glGetIntegerv(GL_BLEND_DST_RGB, &dstRgb_);
-  glGetIntegerv(GL_BLEND_SRC_ALPHA, &srcAlpha_);
-  glGetIntegerv(GL_BLEND_DST_ALPHA, &dstAlpha_);
-  glEnable(GL_BLEND);
-  glBlendEquation(GL_FUNC_ADD);
-  glBlendFunc(GL_ONE, GL_ONE);
-}
-
-ScopedBlendAdd::~ScopedBlendAdd() {
-  glBlendEquationSeparate(static_cast<GLenum>(equationRgb_), static_cast<GLenum>(equationAlpha_));
-  glBlendFuncSeparate(static_cast<GLenum>(srcRgb_), static_cast<GLenum>(dstRgb_), static_cast<GLenum>(srcAlpha_),
-                      static_cast<GLenum>(dstAlpha_));
-  if (!enabled_) glDisable(GL_BLEND);
-}
-
-ScopedDepthTest::ScopedDepthTest(GLenum func) {
-  enabled_ = glIsEnabled(GL_DEPTH_TEST);
-  glGetBooleanv(GL_DEPTH_WRITEMASK, &mask_);
-  glGetIntegerv(GL_DEPTH_FUNC, &func_);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(func);
-  glDepthMask(GL_TRUE);
-}
-
-ScopedDepthTest::~ScopedDepthTest() {
-  glDepthFunc(static_cast<GLenum>(func_));
-  glDepthMask(mask_);
-  if (!enabled_) glDisable(GL_DEPTH_TEST);
-}
-
-ScopedPassBindings::~ScopedPassBindings() {
-  glUseProgram(0);
-  glBindVertexArray(0);
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-}
 
 AtlasLayout AtlasLayout::plan(glm::ivec3 dims, int maxTextureSize, const std::string& source,
                               const std::string& renderer) {
@@ -177,56 +136,6 @@ void AtlasTargets::toFields(Field& irradiance, Field& lightDir) const {
       }
     }
   }
-}
-
-GridUniforms GridUniforms::from(const GridSpec& grid) {
-  GridUniforms u;
-  u.boundsMin = glm::vec3(grid.bounds_min);
-  u.boundsMax = glm::vec3(grid.bounds_max);
-  u.invExtent = glm::vec3(1.0 / grid.extent());
-  const glm::dvec3 h = grid.voxelSize();
-  u.voxelEdge = static_cast<float>(std::min({h.x, h.y, h.z}));
-  u.voxelVolume = static_cast<float>(grid.voxelVolume());
-  u.dims = grid.dims;
-  return u;
-}
-
-void GridUniforms::set(const gl::Program& program) const {
-  program.set("uBoundsMin", boundsMin);
-  program.set("uBoundsMax", boundsMax);
-  program.set("uInvExtent", invExtent);
-  program.set("uVoxelEdge", voxelEdge);
-  program.set("uVoxelVolume", voxelVolume);
-  program.set("uDims", dims);
-}
-
-DepositPass::DepositPass(const gl::ShaderLibrary& library, const AtlasLayout& layout, DepositMode mode)
-    : vao_(gl::VertexArray::create()), mode_(mode) {
-  gl::ShaderDefines defines = layout.defines();
-  defines.emplace_back(mode == DepositMode::Max ? "DEPOSIT_MAX" : "DEPOSIT_ACCUMULATE", "1");
-  program_ = library.program("lightsim/deposit.vert", "lightsim/deposit.frag", defines);
-}
-
-void DepositPass::run(const gl::Texture2D& depositA, const gl::Texture2D& depositB, std::size_t count,
-                      AtlasTargets& atlas, float energyRef) const {
-  if (count == 0) return;
-  ScopedPassBindings unbind;
-  atlas.framebuffer().bind();
-  program_.use();
-  depositA.bind(0);
-  program_.setSampler("uDepositA", 0);
-  depositB.bind(1);
-  program_.setSampler("uDepositB", 1);
-  program_.set("uEnergyRef", energyRef);
-  vao_.bind();
-  if (mode_ == DepositMode::Accumulate) {
-    ScopedBlendAdd blend;
-    glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(count));
-  } else {
-    ScopedDepthTest depth(GL_LESS);
-    glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(count));
-  }
-  gl::checkErrors("DepositPass");
 }
 
 }  // namespace eik

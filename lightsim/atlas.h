@@ -1,12 +1,12 @@
 // Flat 3D ("atlas") render targets for the deposit step (ALGORITHM.md step 4, thesis §6.2.3,
 // Harris et al. 2003): GL 3.3 cannot rasterise into a 3D texture in one draw, so the z-slices of
 // the grid are tiled into one 2D texture, tiles.x slices a row, and each patch is a GL_POINTS
-// primitive that lands on the atlas texel of the voxel holding its midpoint.
+// primitive that lands on the atlas texel of the voxel holding its midpoint (deposit_pass.h).
 //
 //   voxel (i, j, k)  ↔  atlas texel (tx·dims.x + i, ty·dims.y + j),  tx = k mod tiles.x,
 //                                                                   ty = k div tiles.x
 //
-// Deposit modes (DESIGN §5):
+// Deposit modes (docs/physics.md):
 //   accumulate  target 0 += (Φ·Δs_m / V_voxel, 0)           additive blending
 //               target 1 += (lum(Φ)·Δs_m · d, 1)            direction sum, deposit count
 //   max         target 0  = (E, lum(E)), target 1 = (d, 1)  of the patch with the largest lum(E),
@@ -21,52 +21,13 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
-#include "core/grid.h"
 #include "core/volume.h"
 #include "gl/framebuffer.h"
-#include "gl/program.h"
 #include "gl/shader_library.h"
 #include "gl/texture.h"
-#include "gl/vertex_array.h"
 #include "lightsim/simulator.h"
 
 namespace eik {
-
-// Scoped GL state of the point passes (restored on exit, so no state leaks between passes).
-class ScopedBlendAdd {  // blending on, GL_FUNC_ADD with GL_ONE, GL_ONE
- public:
-  ScopedBlendAdd();
-  ~ScopedBlendAdd();
-  ScopedBlendAdd(const ScopedBlendAdd&) = delete;
-  ScopedBlendAdd& operator=(const ScopedBlendAdd&) = delete;
-
- private:
-  GLboolean enabled_ = GL_FALSE;
-  GLint equationRgb_ = 0, equationAlpha_ = 0, srcRgb_ = 0, dstRgb_ = 0, srcAlpha_ = 0, dstAlpha_ = 0;
-};
-
-class ScopedDepthTest {  // depth test on with `func`, depth writes on
- public:
-  explicit ScopedDepthTest(GLenum func);
-  ~ScopedDepthTest();
-  ScopedDepthTest(const ScopedDepthTest&) = delete;
-  ScopedDepthTest& operator=(const ScopedDepthTest&) = delete;
-
- private:
-  GLboolean enabled_ = GL_FALSE;
-  GLboolean mask_ = GL_TRUE;
-  GLint func_ = GL_LESS;
-};
-
-// Unbinds the program, vertex array and framebuffer on exit (also when a pass throws), so that a
-// pass leaves nothing bound that its owner might delete while it is still current.
-class ScopedPassBindings {
- public:
-  ScopedPassBindings() = default;
-  ~ScopedPassBindings();
-  ScopedPassBindings(const ScopedPassBindings&) = delete;
-  ScopedPassBindings& operator=(const ScopedPassBindings&) = delete;
-};
 
 struct AtlasLayout {
   glm::ivec3 dims{0};
@@ -113,35 +74,6 @@ class AtlasTargets {
   gl::Texture2D direction_;
   gl::Texture2D depth_;
   gl::Framebuffer framebuffer_;
-};
-
-// Geometry of the grid as the shaders see it.
-struct GridUniforms {
-  glm::vec3 boundsMin{0.0f};
-  glm::vec3 boundsMax{0.0f};
-  glm::vec3 invExtent{1.0f};  // uvw = (x − boundsMin) · invExtent
-  float voxelEdge = 1.0f;     // h, the smallest voxel edge
-  float voxelVolume = 1.0f;   // V_voxel
-  glm::ivec3 dims{1};         // for EXACT_TRILINEAR sampling
-  static GridUniforms from(const GridSpec& grid);
-  void set(const gl::Program& program) const;
-};
-
-// Step 4: one GL_POINTS primitive per live patch into `atlas`. The analysis pass (gpu_simulator.h,
-// gpu::AnalysisPass) has computed each patch's deposit: depositA = (value, atlas x; x < 0: none),
-// depositB = (direction, atlas y), in the patch list layout (patch k at mortonTexel(k)).
-class DepositPass {
- public:
-  DepositPass(const gl::ShaderLibrary& library, const AtlasLayout& layout, DepositMode mode);
-  // Deposits patches 0 .. count − 1. energyRef: E_ref of the max-mode depth mapping (a positive
-  // irradiance well below the ones that matter).
-  void run(const gl::Texture2D& depositA, const gl::Texture2D& depositB, std::size_t count, AtlasTargets& atlas,
-           float energyRef) const;
-
- private:
-  gl::Program program_;
-  gl::VertexArray vao_;
-  DepositMode mode_;
 };
 
 }  // namespace eik

@@ -1,3 +1,4 @@
+// What a bake adds to a volume, and reading the light to bake (see bake.h).
 #include "lightsim/bake.h"
 
 #include <cerrno>
@@ -8,6 +9,7 @@
 
 #include "core/error.h"
 #include "core/gaussian_filter.h"
+#include "core/scene.h"
 
 namespace eik {
 
@@ -120,6 +122,25 @@ LightSpec parseLight(const std::string& light_text, const std::string& power_tex
     throw InputError("--power", "", "'" + power_text + "': must not be negative");
   if (light.power.x == 0.0 && light.power.y == 0.0 && light.power.z == 0.0)
     throw InputError("--power", "", "'" + power_text + "': must not be zero in every channel");
+  return light;
+}
+
+LightSpec lightFromScene(const std::filesystem::path& file) {
+  Scene scene = readScene(file);
+  if (scene.lights.empty()) throw InputError(file.string(), "lights", "the scene has no light to bake");
+  const SceneLightSpec& l = scene.lights.front();
+  LightSpec light;
+  if (l.type == SceneLightSpec::Type::Directional) {
+    light.type = LightSpec::Type::Directional;
+    light.direction = l.direction;
+    light.power = l.irradiance;
+  } else {
+    light.type = LightSpec::Type::Point;
+    light.position = l.position;
+    light.power = l.intensity;
+  }
+  if (!(light.power.x > 0 || light.power.y > 0 || light.power.z > 0))
+    throw InputError(file.string(), "lights[0]", "the light has no power");
   return light;
 }
 

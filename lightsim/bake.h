@@ -1,7 +1,8 @@
-// What a bake adds to a volume (ALGORITHM.md "Bake output", DESIGN §4.1), and reading the light
-// of `lightsim --light ... --power ...` (DESIGN §4.2).
+// What a bake adds to a volume (ALGORITHM.md "Bake output", docs/volume-format.md), and reading the light
+// of `lightsim --light ... --power ...` or `--scene` (docs/programs.md).
 #pragma once
 
+#include <filesystem>
 #include <string>
 
 #include "core/volume.h"
@@ -26,6 +27,10 @@ void smoothIrradiance(BakeResult& result, const GridSpec& grid, double sigma_vox
 // --power for malformed text, a non-finite number, a zero direction, a negative channel or a power
 // that is zero in every channel.
 LightSpec parseLight(const std::string& light, const std::string& power = "1,1,1");
+
+// The first light of a SCENE.json (`lightsim --scene`), as a LightSpec. Throws InputError naming
+// the file for a scene without lights or a light without power (and what readScene throws).
+LightSpec lightFromScene(const std::filesystem::path& file);
 
 // True when the bake had no initial patch: the light misses the volume (the bake is all zeros).
 inline bool lightMissedVolume(const SimulationStats& stats) { return stats.initial_patches == 0; }

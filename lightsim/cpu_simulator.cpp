@@ -1,7 +1,7 @@
 // The CPU twin: ALGORITHM.md steps 1–6, one patch at a time in stepPatch, the list in run().
 //
-// Where it departs from ALGORITHM.md as written (decisions of this file; the GPU path follows them,
-// see shaders/lightsim/fate.glsl and fresnel.glsl; ALGORITHM.md should be brought in line):
+// Where it goes beyond the thesis (ALGORITHM.md steps 3 and 5 specify these rules; the GPU path
+// follows them in shaders/lightsim/fate.glsl and fresnel.glsl):
 //  - Step 5, `folded`: only in `max` mode. A fold (N·d ≤ 0) is a caustic the light passes
 //    through; what is singular there is E = Φ/A, which only the `max` deposit uses. The
 //    `accumulate` deposit Φ·Δs/V does not involve the area, so the patch simply goes on. Killing
@@ -11,14 +11,14 @@
 //    sphere) before it reached the plane below.
 //  - Step 3, leaving a boundary layer: boundaryReflectance (wavefront.h): no reflection when the
 //    index on leaving is within boundary_off of the index on entering, and the Fresnel angle taken
-//    on the lower-index side. As written, the sphere above reflected 0.44 W instead of ≈ 0.13 W.
+//    on the lower-index side. Without these rules the sphere above reflected 0.44 W instead of
+//    ≈ 0.13 W.
 //  - Step 5, split: an edge > split_voxels·h·(1 + 10⁻⁴) (splitThreshold), so that rounding
 //    does not split initial patches whose edges are exactly one voxel; and by default only along
 //    the axes whose edges are too long (SplitRule::Axis, 1×2 splits: wavefront.h splitAxes).
 #include "lightsim/cpu_simulator.h"
 
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -26,14 +26,11 @@
 #include <vector>
 
 #include "core/parallel.h"
+#include "core/stopwatch.h"
 
 namespace eik {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 // The right-hand side of the wavefront ray equation in time t (Eq. 4.12/4.13):
 // dx/dt = w/n², dw/dt = ∇n/n, with n and ∇n sampled at x.
@@ -128,7 +125,7 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
     patch.flux *= transmitted;
   }
 
-  // 3. Fresnel at boundary layers (DESIGN §5; seeds/README.md formulas).
+  // 3. Fresnel at boundary layers (docs/physics.md; fresnelReflectance, wavefront.h).
   const glm::dvec3 m_new = patch.midpoint();
   const glm::dvec3 d_new = patch.direction();
   const glm::dvec4 ng = sampler.iorAndGradient(m_new);
@@ -235,12 +232,12 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   const unsigned threads = workerThreads();
   stats.renderer = "cpu, " + std::to_string(threads) + (threads == 1 ? " thread" : " threads");
 
-  auto t0 = Clock::now();
+  Stopwatch phase;
   double flux_ref = 0.0;
   std::vector<Patch> patches = initialPatches(light, grid, sampler_, options, &flux_ref);
   stats.initial_patches = patches.size();
   for (const Patch& p : patches) stats.flux_in += p.flux;
-  stats.phase_seconds["init"] = secondsSince(t0);
+  stats.phase_seconds["init"] = phase.seconds();
 
   StepContext ctx;
   ctx.sampler = &sampler_;
@@ -275,7 +272,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
     stats.total_patches += count;
 
     // Steps 1–5 per patch, in parallel (each patch independent: deterministic).
-    auto t = Clock::now();
+    Stopwatch t;
     results.resize(count);
     parallelFor(
         0, static_cast<std::int64_t>(count),
@@ -284,10 +281,10 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
           results[i] = stepPatch(patches[i], samples[i], ctx);
         },
         256);
-    t_update += secondsSince(t);
+    t_update += t.seconds();
 
     // Deposit and the ledger, sequentially in patch order (deterministic sums).
-    t = Clock::now();
+    t.restart();
     offsets.resize(count + 1);
     std::uint64_t total = 0;
     for (std::size_t i = 0; i < count; ++i) {
@@ -333,11 +330,11 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
       }
     }
     offsets[count] = total;
-    t_deposit += secondsSince(t);
+    t_deposit += t.seconds();
 
     // Step 6: compaction and expansion by the prefix sum, in index order (the histogram pyramid's
     // order: output slot k of source s with sub-index j = child j of the split).
-    t = Clock::now();
+    t.restart();
     next.resize(total);
     next_samples.resize(total);
     parallelFor(
@@ -363,7 +360,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
         256);
     patches.swap(next);
     samples.swap(next_samples);
-    t_compact += secondsSince(t);
+    t_compact += t.seconds();
 
     if (options.progress && total_in > 0.0) {
       const double retired =
@@ -374,7 +371,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   for (const Patch& p : patches) stats.flux_unfinished += p.flux;
 
   // Output fields.
-  t0 = Clock::now();
+  phase.restart();
   bake.irradiance.components = 3;
   bake.irradiance.data.assign(voxels * 3, 0.0f);
   bake.light_dir.components = 3;
@@ -396,7 +393,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   stats.phase_seconds["update"] = t_update;
   stats.phase_seconds["deposit"] = t_deposit;
   stats.phase_seconds["compact"] = t_compact;
-  stats.phase_seconds["output"] = secondsSince(t0);
+  stats.phase_seconds["output"] = phase.seconds();
   if (options.progress) options.progress(1.0);
   return bake;
 }

@@ -1,15 +1,14 @@
-// The CPU twin of the light simulator against analytic answers (DESIGN §6): energy, Fresnel,
+// The CPU twin of the light simulator against analytic answers (docs/testing.md): energy, Fresnel,
 // Beer–Lambert, the ball lens, the Luneburg lens, shadows, point lights and determinism.
 //
 // Scenes are built in memory with the voxelizer (test_scenes.h) and assume its default
-// pre-smoothing of n, σ = 0.75 voxel (DESIGN §5: tests state the σ they assume). All run in a few
+// pre-smoothing of n, σ = 0.75 voxel (docs/physics.md: tests state the σ they assume). All run in a few
 // seconds on two cores in a Release build.
 #include "lightsim/cpu_simulator.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -19,6 +18,7 @@
 #include <vector>
 
 #include "core/parallel.h"
+#include "core/stopwatch.h"
 #include "lightsim/bake.h"
 #include "lightsim/test_scenes.h"
 
@@ -602,9 +602,9 @@ TEST(CpuBench, DISABLED_GlassSphere) {
     std::vector<double> seconds;
     BakeResult r;
     for (int i = 0; i < repeat; ++i) {
-      const auto t0 = std::chrono::steady_clock::now();
+      const Stopwatch watch;
       r = sim.run(light, {});
-      seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      seconds.push_back(watch.seconds());
     }
     std::sort(seconds.begin(), seconds.end());
     const double median = seconds[seconds.size() / 2];

@@ -1,9 +1,8 @@
-// The GPU light simulator: passes, the step loop, the ledger and phase timing (see gpu_simulator.h).
+// The GPU light simulator's step loop (see gpu_simulator.h): GpuSimulator::Impl owns the volume
+// textures, the passes (made on first use) and the ledger, and run() drives one bake through them.
 #include "lightsim/gpu_simulator.h"
 
 #include <algorithm>
-#include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -11,354 +10,33 @@
 #include <vector>
 
 #include "core/error.h"
-#include "gl/debug.h"
-#include "gl/framebuffer.h"
-#include "gl/handle.h"
+#include "core/stopwatch.h"
+#include "gl/scoped_state.h"
 #include "gl/shader_library.h"
-#include "gl/vertex_array.h"
+#include "gl/time_query.h"
 #include "gl/volume_textures.h"
+#include "lightsim/analysis_pass.h"
 #include "lightsim/atlas.h"
+#include "lightsim/compact_pass.h"
+#include "lightsim/deposit_pass.h"
+#include "lightsim/grid_uniforms.h"
 #include "lightsim/histo_pyramid.h"
+#include "lightsim/ledger_pass.h"
+#include "lightsim/list_set.h"
 #include "lightsim/patch_textures.h"
+#include "lightsim/step_uniforms.h"
+#include "lightsim/update_pass.h"
 #include "lightsim/wavefront.h"
 
 namespace eik {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
 std::string bytesText(std::size_t bytes) {
   char text[64];
   std::snprintf(text, sizeof text, "%.1f MiB", static_cast<double>(bytes) / (1024.0 * 1024.0));
   return text;
 }
-
-// Ledger columns (shaders/lightsim/ledger.vert).
-enum LedgerColumn {
-  kAbsorbed = 0,
-  kReflected,
-  kExited,
-  kKilledFlux,
-  kFolded,
-  kKilledDepth,
-  kSplits,
-  kUnfinished,
-  kLedgerColumns
-};
-
-// ---------------------------------------------------------------------------------------------
-// Phase timing (GpuSimulatorOptions::Timing).
-
-struct QueryTraits {
-  static void destroy(GLuint name) { glDeleteQueries(1, &name); }
-};
-
-class PhaseTimer {
- public:
-  PhaseTimer(GpuSimulatorOptions::Timing mode, std::map<std::string, double>& out) : mode_(mode), out_(out) {}
-  ~PhaseTimer() {
-    // Leave no query active (results that are not collected are dropped).
-    if (mode_ == GpuSimulatorOptions::Timing::Queries && running_) glEndQuery(GL_TIME_ELAPSED);
-  }
-  PhaseTimer(const PhaseTimer&) = delete;
-  PhaseTimer& operator=(const PhaseTimer&) = delete;
-
-  // Ends the running phase and starts `name`.
-  void start(const char* name) {
-    stop();
-    if (mode_ != GpuSimulatorOptions::Timing::Finish && mode_ != GpuSimulatorOptions::Timing::Queries) return;
-    running_ = true;
-    name_ = name;
-    if (mode_ == GpuSimulatorOptions::Timing::Finish) {
-      start_ = Clock::now();
-    } else {
-      if (free_.empty()) {
-        GLuint id = 0;
-        glGenQueries(1, &id);
-        free_.emplace_back(id);
-      }
-      pending_.push_back({name_, std::move(free_.back())});
-      free_.pop_back();
-      glBeginQuery(GL_TIME_ELAPSED, pending_.back().query.get());
-    }
-  }
-
-  void stop() {
-    if (!running_) return;
-    running_ = false;
-    if (mode_ == GpuSimulatorOptions::Timing::Finish) {
-      glFinish();
-      out_[name_] += secondsSince(start_);
-    } else if (mode_ == GpuSimulatorOptions::Timing::Queries) {
-      glEndQuery(GL_TIME_ELAPSED);
-    }
-  }
-
-  // Adds the results of finished queries (all of them, waiting, with `wait`).
-  void collect(bool wait) {
-    if (mode_ != GpuSimulatorOptions::Timing::Queries) return;
-    std::size_t done = 0;
-    for (; done < pending_.size(); ++done) {
-      Pending& p = pending_[done];
-      if (running_ && done + 1 == pending_.size()) break;  // the active one
-      if (!wait) {
-        GLint available = 0;
-        glGetQueryObjectiv(p.query.get(), GL_QUERY_RESULT_AVAILABLE, &available);
-        if (!available) break;
-      }
-      GLuint64 ns = 0;
-      glGetQueryObjectui64v(p.query.get(), GL_QUERY_RESULT, &ns);
-      out_[p.name] += static_cast<double>(ns) * 1e-9;
-      free_.push_back(std::move(p.query));
-    }
-    pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(done));
-  }
-
- private:
-  struct Pending {
-    std::string name;
-    gl::GlHandle<QueryTraits> query;
-  };
-  GpuSimulatorOptions::Timing mode_;
-  std::map<std::string, double>& out_;
-  bool running_ = false;
-  std::string name_;
-  Clock::time_point start_;
-  std::vector<Pending> pending_;
-  std::vector<gl::GlHandle<QueryTraits>> free_;
-};
-
-// Sets the viewport to the live box of a list (after Framebuffer::bind set it to the whole list).
-void viewportBox(glm::ivec2 box) { glViewport(0, 0, box.x, box.y); }
-
-const gl::Sampling kNearest{gl::Filter::Nearest, gl::Wrap::ClampToEdge};
-
-const char* integratorDefine(Integrator integrator) {
-  switch (integrator) {
-    case Integrator::RK4: return "INTEGRATOR_RK4";
-    case Integrator::RK2: return "INTEGRATOR_RK2";
-    case Integrator::Euler: break;
-  }
-  return "INTEGRATOR_EULER";
-}
-
-const char* depositDefine(DepositMode mode) { return mode == DepositMode::Max ? "DEPOSIT_MAX" : "DEPOSIT_ACCUMULATE"; }
-
-}  // namespace
-
-// ---------------------------------------------------------------------------------------------
-// Passes (gpu_simulator.h).
-
-namespace gpu {
-
-StepTargets::StepTargets(int side, const gl::ShaderLibrary& library)
-    : pyramid(side, library),
-      depositA({side, side}, gl::TextureFormat::RGBA32F, kNearest),
-      depositB({side, side}, gl::TextureFormat::RGBA32F, kNearest),
-      ledgerA({side, side}, gl::TextureFormat::RGBA32F, kNearest),
-      ledgerB({side, side}, gl::TextureFormat::RGBA32F, kNearest),
-      framebuffer({side, side}) {
-  framebuffer.attach(0, pyramid.base());
-  framebuffer.attach(1, depositA);
-  framebuffer.attach(2, depositB);
-  framebuffer.attach(3, ledgerA);
-  framebuffer.attach(4, ledgerB);
-  framebuffer.checkComplete();
-}
-
-std::size_t StepTargets::bytesFor(int side) {
-  // Pyramid: R32F base + RGBA32F levels (16/3 B a slot); four RGBA32F targets.
-  const std::size_t texels = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
-  return texels * 4 + texels * 16 / 3 + 4 * texels * 16;
-}
-
-UpdatePass::UpdatePass(const gl::ShaderLibrary& library, Integrator integrator, const std::string& volumeDefines)
-    : program_(library.program("common/fullscreen.vert", "lightsim/update.frag", {{integratorDefine(integrator), "1"}},
-                               volumeDefines)) {}
-
-void UpdatePass::run(const PatchTextures& in, PatchTextures& out, std::size_t count, const gl::VolumeTextures& volume,
-                     const GridUniforms& grid, const StepUniforms& step) const {
-  ScopedPassBindings unbind;
-  out.framebuffer().bind();
-  viewportBox(mortonBox(count));
-  program_.use();
-  volume.bind(program_, in.bind(program_, "uPatch", 0));
-  grid.set(program_);
-  program_.set("uCount", static_cast<int>(count));
-  program_.set("uDt", step.dt);
-  program_.set("uBoundaryOn", step.boundaryOn);
-  program_.set("uBoundaryOff", step.boundaryOff);
-  triangle_.draw();
-  gl::checkErrors("UpdatePass");
-}
-
-AnalysisPass::AnalysisPass(const gl::ShaderLibrary& library, DepositMode mode, const AtlasLayout& atlas,
-                           const std::string& volumeDefines) {
-  gl::ShaderDefines defines = atlas.defines();
-  defines.emplace_back(depositDefine(mode), "1");
-  program_ = library.program("common/fullscreen.vert", "lightsim/analysis.frag", defines, volumeDefines);
-}
-
-void AnalysisPass::run(const PatchTextures& current, const PatchTextures& previous, std::size_t count,
-                       StepTargets& targets, const gl::VolumeTextures& volume, const GridUniforms& grid,
-                       const StepUniforms& step) const {
-  ScopedPassBindings unbind;
-  targets.framebuffer.bind();
-  viewportBox(mortonBox(count));
-  program_.use();
-  int unit = current.bind(program_, "uPatch", 0);  // 8 units
-  for (int c = 0; c < 4; ++c, ++unit) {
-    previous.texture(PatchTextures::kP0 + c).bind(unit);
-    program_.setSampler("uPrevious[" + std::to_string(c) + "]", unit);
-  }
-  previous.texture(PatchTextures::kFlux).bind(unit);
-  program_.setSampler("uPreviousFlux", unit++);
-  volume.bind(program_, unit);  // at most 2 (optics, absorption): 15 of the 16 units GL 3.3 guarantees
-  grid.set(program_);
-  program_.set("uCount", static_cast<int>(count));
-  program_.set("uDt", step.dt);
-  program_.set("uFluxKill", step.fluxKill);
-  program_.set("uSplitLength", step.splitLength);
-  program_.set("uMaxDepth", step.maxDepth);
-  program_.set("uAxisSplit", step.axisSplit);
-  program_.set("uKillAtMaxDepth", step.killAtMaxDepth);
-  triangle_.draw();
-  gl::checkErrors("AnalysisPass");
-}
-
-CompactPass::CompactPass(const gl::ShaderLibrary& library, const gl::ShaderDefines& pyramidDefines,
-                         const std::string& volumeDefines)
-    : program_(library.program("common/fullscreen.vert", "lightsim/compact.frag", pyramidDefines, volumeDefines)) {}
-
-void CompactPass::run(const PatchTextures& in, const StepTargets& targets, PatchTextures& out, std::size_t total,
-                      const gl::VolumeTextures& volume, const GridUniforms& grid) const {
-  ScopedPassBindings unbind;
-  out.framebuffer().bind();
-  viewportBox(mortonBox(total));
-  program_.use();
-  int unit = in.bind(program_, "uPatch", 0);
-  targets.pyramid.bind(unit);
-  program_.setSampler("uPyramid", unit++);
-  targets.ledgerA.bind(unit);
-  program_.setSampler("uLedgerA", unit++);
-  volume.bind(program_, unit);
-  grid.set(program_);
-  program_.set("uTotal", static_cast<int>(total));
-  triangle_.draw();
-  gl::checkErrors("CompactPass");
-}
-
-}  // namespace gpu
-
-namespace {
-
-// The energy ledger: kLedgerColumns RGBA32F targets of kBins × rows texels, one row per step,
-// summed with additive blending (one point per patch writes all its entries, MRT), read back and
-// folded into double sums every `rows` steps.
-class Ledger {
- public:
-  static constexpr int kBins = 256;  // texels per row (patch k adds into bin k mod kBins)
-
-  Ledger(const gl::ShaderLibrary& library, int rows)
-      : rows_(std::max(1, rows)),
-        target_({kBins, rows_}, std::vector<gl::TextureFormat>(kLedgerColumns, gl::TextureFormat::RGBA32F)),
-        step_(library.program("lightsim/ledger.vert", "lightsim/ledger.frag")),
-        unfinished_(library.program("lightsim/ledger.vert", "lightsim/ledger.frag", {{"LEDGER_UNFINISHED", "1"}})),
-        vao_(gl::VertexArray::create()) {
-    clear();
-  }
-
-  bool full() const { return row_ == rows_; }
-  // Zero sums and rows, for a new run.
-  void reset() {
-    clear();
-    row_ = 0;
-    sums_ = {};
-  }
-
-  // The entries of one step, from the analysis of the updated list `current`.
-  void addStep(const gpu::StepTargets& targets, const PatchTextures& current, std::size_t count) {
-    draw(step_, [&] {
-      targets.ledgerA.bind(0);
-      step_.setSampler("uLedgerA", 0);
-      targets.ledgerB.bind(1);
-      step_.setSampler("uLedgerB", 1);
-      current.texture(PatchTextures::kFlux).bind(2);
-      step_.setSampler("uFlux", 2);
-    }, count);
-  }
-  // The flux of the patches still alive at the end.
-  void addUnfinished(const PatchTextures& list, std::size_t count) {
-    draw(unfinished_, [&] {
-      list.texture(PatchTextures::kFlux).bind(0);
-      unfinished_.setSampler("uFlux", 0);
-    }, count);
-  }
-
-  // Reads the rows written so far, adds them to the sums and clears them.
-  void flush() {
-    if (row_ == 0) return;
-    for (int c = 0; c < kLedgerColumns; ++c) {
-      const std::vector<float> data = target_.readRGBA(c);
-      const std::size_t used = static_cast<std::size_t>(row_) * kBins;  // rows from the bottom
-      for (std::size_t i = 0; i < used; ++i) {
-        sums_[static_cast<std::size_t>(c)] += glm::dvec4(data[i * 4], data[i * 4 + 1], data[i * 4 + 2], data[i * 4 + 3]);
-      }
-    }
-    clear();
-    row_ = 0;
-  }
-
-  const glm::dvec4& sum(LedgerColumn column) const { return sums_[static_cast<std::size_t>(column)]; }
-
- private:
-  void clear() {
-    for (int c = 0; c < kLedgerColumns; ++c) target_.clear(c, glm::vec4(0.0f));
-  }
-
-  template <class Setup>
-  void draw(const gl::Program& program, Setup&& setup, std::size_t points) {
-    if (full()) flush();
-    if (points > 0) {
-      ScopedPassBindings unbind;
-      target_.bind();
-      program.use();
-      setup();
-      program.set("uRow", row_);
-      program.set("uBins", kBins);
-      program.set("uLedgerSize", glm::vec2(static_cast<float>(kBins), static_cast<float>(rows_)));
-      ScopedBlendAdd blend;
-      vao_.bind();
-      glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(points));
-      gl::checkErrors("Ledger");
-    }
-    ++row_;
-  }
-
-  int rows_;
-  int row_ = 0;
-  gl::Framebuffer target_;
-  gl::Program step_;
-  gl::Program unfinished_;
-  gl::VertexArray vao_;
-  std::array<glm::dvec4, kLedgerColumns> sums_{};
-};
-
-// The two patch lists of one side and the targets of their analysis.
-struct ListSet {
-  PatchTextures a, b;  // a: the current list; b: the updated one
-  gpu::StepTargets targets;
-
-  ListSet(int side, const gl::ShaderLibrary& library) : a(side), b(side), targets(side, library) {}
-  int side() const { return a.side(); }
-  static std::size_t bytesFor(int side) {
-    const std::size_t texels = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
-    return 2 * texels * PatchTextures::kAttachments * 16 + gpu::StepTargets::bytesFor(side);
-  }
-};
 
 // Only the fields the simulator reads, so nothing else takes texture memory.
 Volume simulationFields(const Volume& volume) {
@@ -371,8 +49,6 @@ Volume simulationFields(const Volume& volume) {
 }
 
 }  // namespace
-
-// ---------------------------------------------------------------------------------------------
 
 struct GpuSimulator::Impl {
   GpuSimulatorOptions config;
@@ -387,15 +63,15 @@ struct GpuSimulator::Impl {
   // The GPU works in grid-local coordinates, x − centre of the grid, so float positions keep their
   // precision however far the volume sits from the world origin.
   glm::dvec3 origin{0.0};
-  GridUniforms gridUniforms;
+  gpu::GridUniforms gridUniforms;
   GpuRunInfo info;
 
   // Programs, made on first use and kept across runs.
   std::map<Integrator, std::unique_ptr<gpu::UpdatePass>> updates;
-  std::map<DepositMode, std::unique_ptr<DepositPass>> deposits;
+  std::map<DepositMode, std::unique_ptr<gpu::DepositPass>> deposits;
   std::map<DepositMode, std::unique_ptr<gpu::AnalysisPass>> analyses;
   std::map<int, std::unique_ptr<gpu::CompactPass>> compacts;  // by pyramid levels
-  std::unique_ptr<Ledger> ledger;
+  std::unique_ptr<gpu::LedgerPass> ledger;
 
   Impl(const Volume& v, const GpuSimulatorOptions& o)
       : config(o),
@@ -407,7 +83,7 @@ struct GpuSimulator::Impl {
         volume(uploadVolume(v, o)),
         volumeDefines(volume.layout().glslDefines() + (o.exact_sampling ? "#define EXACT_TRILINEAR 1\n" : "")),
         origin(0.5 * (grid.bounds_min + grid.bounds_max)),
-        gridUniforms(GridUniforms::from(localGrid(grid, origin))) {}
+        gridUniforms(gpu::GridUniforms::from(localGrid(grid, origin))) {}
 
   static GridSpec localGrid(GridSpec g, const glm::dvec3& origin) {
     g.bounds_min -= origin;
@@ -426,7 +102,7 @@ struct GpuSimulator::Impl {
     const std::size_t fields =
         v.grid.count() * ((v.has("ior") || v.has("ior_grad") ? 16 : 0) + (v.has("sigma_a") ? 12 : 0));
     const std::size_t budget = o.budget_bytes ? o.budget_bytes : gl::defaultTextureBudget();
-    const std::size_t needed = fields + AtlasTargets::bytesFor(layout, DepositMode::Max) + ListSet::bytesFor(64);
+    const std::size_t needed = fields + AtlasTargets::bytesFor(layout, DepositMode::Max) + gpu::ListSet::bytesFor(64);
     if (needed > budget) {
       throw InputError(o.source, "dims",
                        "volume too large for the GPU: the light simulator needs at least " + bytesText(needed) +
@@ -460,9 +136,9 @@ struct GpuSimulator::Impl {
     if (!p) p = std::make_unique<gpu::UpdatePass>(library, i, volumeDefines);
     return *p;
   }
-  DepositPass& deposit(DepositMode m) {
+  gpu::DepositPass& deposit(DepositMode m) {
     auto& p = deposits[m];
-    if (!p) p = std::make_unique<DepositPass>(library, atlasLayout, m);
+    if (!p) p = std::make_unique<gpu::DepositPass>(library, atlasLayout, m);
     return *p;
   }
   gpu::AnalysisPass& analyse(DepositMode m) {
@@ -475,23 +151,34 @@ struct GpuSimulator::Impl {
     if (!p) p = std::make_unique<gpu::CompactPass>(library, pyramid.defines(), volumeDefines);
     return *p;
   }
-  GpuSimulatorOptions::Timing timingMode() const {
-    if (config.timing != GpuSimulatorOptions::Timing::Auto) return config.timing;
+  // GpuSimulatorOptions::timing, Auto resolved for the current renderer.
+  gl::PhaseTimer::Mode timingMode() const {
+    switch (config.timing) {
+      case GpuSimulatorOptions::Timing::Off: return gl::PhaseTimer::Mode::Off;
+      case GpuSimulatorOptions::Timing::Queries: return gl::PhaseTimer::Mode::Queries;
+      case GpuSimulatorOptions::Timing::Finish: return gl::PhaseTimer::Mode::Finish;
+      case GpuSimulatorOptions::Timing::Auto: break;
+    }
     const std::string& r = gl::GlContext::current()->info().renderer;
     const bool software = r.find("llvmpipe") != std::string::npos || r.find("softpipe") != std::string::npos ||
                           r.find("swrast") != std::string::npos;
-    return software ? GpuSimulatorOptions::Timing::Off : GpuSimulatorOptions::Timing::Queries;
+    return software ? gl::PhaseTimer::Mode::Off : gl::PhaseTimer::Mode::Queries;
   }
-  Ledger& ledgerFor() {
-    if (!ledger) ledger = std::make_unique<Ledger>(library, config.ledger_interval);
+  gpu::LedgerPass& ledgerFor() {
+    if (!ledger) ledger = std::make_unique<gpu::LedgerPass>(library, config.ledger_interval);
     return *ledger;
   }
 
   BakeResult run(const LightSpec& light, const SimulationOptions& options);
 };
 
-GpuSimulator::GpuSimulator(const Volume& volume, GpuSimulatorOptions options) {
-  if (!gl::GlContext::current()) {
+GpuSimulator::GpuSimulator(const Volume& volume, GpuSimulatorOptions options)
+    : GpuSimulator(volume, std::move(options), nullptr) {}
+
+GpuSimulator::GpuSimulator(const Volume& volume, GpuSimulatorOptions options, std::unique_ptr<gl::GlContext> context)
+    : ownedContext_(std::move(context)) {
+  if (ownedContext_ && gl::GlContext::current() != ownedContext_.get()) ownedContext_->makeCurrent();
+  if (!ownedContext_ && !gl::GlContext::current()) {  // none given, none current: a headless one
     gl::ContextOptions co;
     co.backend = options.backend;
     ownedContext_ = std::make_unique<gl::GlContext>(co);
@@ -509,12 +196,22 @@ BakeResult GpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   return impl_->run(light, options);
 }
 
+nlohmann::json GpuSimulator::lastRunStats() const {
+  const GpuRunInfo& info = impl_->info;
+  nlohmann::json stats = nlohmann::json::object();
+  stats["texture_bytes"] = {{"volume", info.volume_bytes},
+                            {"atlas", info.atlas_bytes},
+                            {"patch_lists_peak", info.patch_bytes_peak},
+                            {"total_peak", info.texture_bytes_peak}};
+  return stats;
+}
+
 const GpuRunInfo& GpuSimulator::lastRunInfo() const { return impl_->info; }
 std::string GpuSimulator::renderer() const { return impl_->renderer; }
 
 BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptions& options) {
-  const auto runStart = Clock::now();
-  ScopedPassBindings unbind;  // also when a step throws
+  const Stopwatch runWatch;
+  gl::ScopedPassBindings unbind;  // also when a step throws
   BakeResult bake;
   SimulationStats& stats = bake.stats;
   stats.backend = "gl";
@@ -528,7 +225,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   bake.light_dir.components = 3;
 
   // Initialisation (§6.2.1) on the CPU, shared with the twin.
-  auto t0 = Clock::now();
+  Stopwatch phaseWatch;
   double fluxRef = 0.0;
   const std::vector<Patch> initial = initialPatches(light, grid, sampler, options, &fluxRef);
   stats.initial_patches = initial.size();
@@ -536,9 +233,9 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   if (initial.empty()) {  // the light misses the volume: an empty bake
     bake.irradiance.data.assign(voxels * 3, 0.0f);
     bake.light_dir.data.assign(voxels * 3, 0.0f);
-    stats.phase_seconds["init"] = secondsSince(t0);
+    stats.phase_seconds["init"] = phaseWatch.seconds();
     if (options.progress) options.progress(1.0);
-    info.wall_seconds = secondsSince(runStart);
+    info.wall_seconds = runWatch.seconds();
     stats.phase_seconds["total"] = info.wall_seconds;
     return bake;
   }
@@ -555,25 +252,16 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   }
 
   const int firstSide = std::min(maxSide, patchSideFor(initial.size(), 64));
-  std::unique_ptr<ListSet> lists = std::make_unique<ListSet>(firstSide, library);
+  std::unique_ptr<gpu::ListSet> lists = std::make_unique<gpu::ListSet>(firstSide, library);
   lists->a.upload(packed);
   info.initial_patch_side = info.peak_patch_side = firstSide;
 
   AtlasTargets atlas(atlasLayout, options.deposit);
   info.atlas_bytes = atlas.bytes();
-  Ledger& ledger = ledgerFor();
+  gpu::LedgerPass& ledger = ledgerFor();
   ledger.reset();
 
-  const double dt = timeStep(grid, options);
-  gpu::StepUniforms step;
-  step.dt = static_cast<float>(dt);
-  step.boundaryOn = static_cast<float>(options.boundary_on);
-  step.boundaryOff = static_cast<float>(options.boundary_off);
-  step.fluxKill = static_cast<float>(options.flux_threshold * fluxRef);
-  step.splitLength = static_cast<float>(splitThreshold(grid, options));  // split_voxels·h·(1 + margin)
-  step.maxDepth = static_cast<float>(options.max_depth);
-  step.axisSplit = options.split_rule == SplitRule::Axis;
-  step.killAtMaxDepth = options.at_max_depth == DepthLimit::Kill;
+  const gpu::StepUniforms step = gpu::StepUniforms::from(grid, options, fluxRef);
   // E_ref of the max-mode depth mapping: a small irradiance, so that bright patches get depths near
   // 0 where Depth32F is most precise (largest initial E / 1000).
   double eRef = 0.0;
@@ -581,21 +269,22 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   const float energyRef = static_cast<float>(std::max(eRef * 1e-3, 1e-30));
 
   const gpu::UpdatePass& updatePass = update(options.integrator);
-  const DepositPass& depositPass = deposit(options.deposit);
+  const gpu::DepositPass& depositPass = deposit(options.deposit);
   const gpu::AnalysisPass& analysisPass = analyse(options.deposit);
-  stats.phase_seconds["init"] = secondsSince(t0);
+  stats.phase_seconds["init"] = phaseWatch.seconds();
 
   const int maxSteps = eik::maxSteps(grid, options);
   const double totalIn = luminance(stats.flux_in);
   std::size_t count = initial.size();
   stats.peak_patches = count;
-  PhaseTimer timer(timingMode(), stats.phase_seconds);
+  gl::PhaseTimer timer(timingMode(), stats.phase_seconds);
   auto report = [&] {
     ledger.flush();
     timer.collect(false);
     if (options.progress && totalIn > 0.0) {
-      const glm::dvec4 retired = ledger.sum(kExited) + ledger.sum(kAbsorbed) + ledger.sum(kReflected) +
-                                 ledger.sum(kKilledFlux) + ledger.sum(kFolded) + ledger.sum(kKilledDepth);
+      const glm::dvec4 retired = ledger.sum(gpu::kExited) + ledger.sum(gpu::kAbsorbed) +
+                                 ledger.sum(gpu::kReflected) + ledger.sum(gpu::kKilledFlux) +
+                                 ledger.sum(gpu::kFolded) + ledger.sum(gpu::kKilledDepth);
       options.progress(std::min(1.0, luminance(glm::dvec3(retired)) / totalIn));
     }
   };
@@ -604,7 +293,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     stats.steps = s + 1;
     stats.total_patches += count;
     stats.peak_patches = std::max<std::uint64_t>(stats.peak_patches, count);  // live at a step's start
-    ListSet& L = *lists;
+    gpu::ListSet& L = *lists;
 
     timer.start("update");
     updatePass.run(L.a, L.b, count, volume, gridUniforms, step);
@@ -617,9 +306,9 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     timer.start("pyramid");
     L.targets.pyramid.build(count);
     timer.stop();
-    const auto readStart = Clock::now();
+    const Stopwatch readWatch;
     const std::uint64_t total = L.targets.pyramid.readTotal();
-    stats.phase_seconds["readback"] += secondsSince(readStart);
+    stats.phase_seconds["readback"] += readWatch.seconds();
 
     if (total > L.a.capacity()) {
       // Grow: a new pair of lists of the side that holds `total`; compaction writes the new list
@@ -633,8 +322,8 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
       }
       const int side = std::min(maxSide, patchSideFor(total, L.side() * 2));
       const std::size_t budget = config.budget_bytes ? config.budget_bytes : gl::defaultTextureBudget();
-      const std::size_t needed = info.volume_bytes + info.atlas_bytes + ListSet::bytesFor(L.side()) +
-                                 ListSet::bytesFor(side);  // the old set lives until the compaction
+      const std::size_t needed = info.volume_bytes + info.atlas_bytes + gpu::ListSet::bytesFor(L.side()) +
+                                 gpu::ListSet::bytesFor(side);  // the old set lives until the compaction
       if (needed > budget) {
         throw RuntimeError("GPU light simulator: step " + std::to_string(s + 1) + " needs " + std::to_string(total) +
                            " patches, a patch list of " + std::to_string(side) + "x" + std::to_string(side) +
@@ -643,7 +332,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
                            "max_depth");
       }
       timer.start("grow");
-      auto grown = std::make_unique<ListSet>(side, library);
+      auto grown = std::make_unique<gpu::ListSet>(side, library);
       timer.start("compact");
       compact(L.targets.pyramid).run(L.b, L.targets, grown->a, total, volume, gridUniforms);
       timer.stop();
@@ -661,24 +350,25 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   report();
   timer.collect(true);
 
-  stats.splits = static_cast<std::uint64_t>(std::llround(ledger.sum(kSplits).w));
-  stats.kills.exited = static_cast<std::uint64_t>(std::llround(ledger.sum(kExited).w));
-  stats.kills.flux = static_cast<std::uint64_t>(std::llround(ledger.sum(kKilledFlux).w));
-  stats.kills.folded = static_cast<std::uint64_t>(std::llround(ledger.sum(kFolded).w));
-  stats.kills.depth = static_cast<std::uint64_t>(std::llround(ledger.sum(kKilledDepth).w));
-  stats.flux_absorbed = glm::dvec3(ledger.sum(kAbsorbed));
-  stats.flux_reflected = glm::dvec3(ledger.sum(kReflected));
-  stats.flux_out = glm::dvec3(ledger.sum(kExited));
-  stats.flux_killed = glm::dvec3(ledger.sum(kKilledFlux) + ledger.sum(kFolded) + ledger.sum(kKilledDepth));
-  stats.flux_unfinished = glm::dvec3(ledger.sum(kUnfinished));
+  stats.splits = static_cast<std::uint64_t>(std::llround(ledger.sum(gpu::kSplits).w));
+  stats.kills.exited = static_cast<std::uint64_t>(std::llround(ledger.sum(gpu::kExited).w));
+  stats.kills.flux = static_cast<std::uint64_t>(std::llround(ledger.sum(gpu::kKilledFlux).w));
+  stats.kills.folded = static_cast<std::uint64_t>(std::llround(ledger.sum(gpu::kFolded).w));
+  stats.kills.depth = static_cast<std::uint64_t>(std::llround(ledger.sum(gpu::kKilledDepth).w));
+  stats.flux_absorbed = glm::dvec3(ledger.sum(gpu::kAbsorbed));
+  stats.flux_reflected = glm::dvec3(ledger.sum(gpu::kReflected));
+  stats.flux_out = glm::dvec3(ledger.sum(gpu::kExited));
+  stats.flux_killed =
+      glm::dvec3(ledger.sum(gpu::kKilledFlux) + ledger.sum(gpu::kFolded) + ledger.sum(gpu::kKilledDepth));
+  stats.flux_unfinished = glm::dvec3(ledger.sum(gpu::kUnfinished));
 
-  t0 = Clock::now();
+  phaseWatch.restart();
   atlas.toFields(bake.irradiance, bake.light_dir);
-  stats.phase_seconds["output"] = secondsSince(t0);
+  stats.phase_seconds["output"] = phaseWatch.seconds();
 
-  info.patch_bytes_peak = ListSet::bytesFor(info.peak_patch_side);
+  info.patch_bytes_peak = gpu::ListSet::bytesFor(info.peak_patch_side);
   info.texture_bytes_peak = info.volume_bytes + info.atlas_bytes + info.patch_bytes_peak;
-  info.wall_seconds = secondsSince(runStart);
+  info.wall_seconds = runWatch.seconds();
   stats.phase_seconds["total"] = info.wall_seconds;
   if (options.progress) options.progress(1.0);
   return bake;

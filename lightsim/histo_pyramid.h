@@ -1,6 +1,6 @@
 // The histogram pyramid of ALGORITHM.md step 6 (Ziegler, Tevs, Theobalt, Seidel 2006, with the RGBA
 // node layout of Dyken et al. 2008): stream compaction and expansion of the patch list in OpenGL 3.3
-// fragment shaders, and its CPU reference.
+// fragment shaders. (Its CPU reference, HistoPyramidCpu, is test-only: histo_pyramid_cpu.h.)
 //
 // Layout
 //   * The base (level 0): one count per patch slot, an R32F texture of side 2^K — base(), which a
@@ -48,7 +48,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
-#include <span>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -60,11 +59,12 @@
 #include "gl/shader_library.h"
 #include "gl/texture.h"
 #include "gl/vertex_array.h"
+#include "lightsim/morton.h"
 
 namespace eik {
 
 // ---------------------------------------------------------------------------------------------
-// Slots (Morton order), shared by the GPU pyramid and the CPU reference.
+// Slots (Morton order), shared by the GPU pyramid and the CPU reference (histo_pyramid_cpu.h).
 
 struct HistoPyramidLimits {
   static constexpr int kMaxBaseSize = 4096;
@@ -72,54 +72,15 @@ struct HistoPyramidLimits {
   static constexpr std::size_t kAllSlots = std::numeric_limits<std::size_t>::max();
 };
 
-// Slot (list index) → texel and back (Morton; valid at every level of the pyramid).
-glm::ivec2 hpSlotTexel(std::uint32_t slot);
-std::uint32_t hpTexelSlot(glm::ivec2 texel);
-// The smallest power-of-two rectangle at the origin holding slots 0 .. count − 1: 2^⌈b/2⌉ × 2^⌊b/2⌋
-// with b the bit length of count − 1; (0, 0) for count 0. A viewport for passes over the first
-// `count` slots (std::out_of_range above 2^32). (Equal to lightsim/patch_textures.h's mortonBox.)
-glm::ivec2 hpLiveBox(std::uint64_t count);
+// Slot (list index) → texel and back (Morton, lightsim/morton.h; valid at every level of the
+// pyramid), and the rectangle holding the first `count` slots.
+inline glm::ivec2 hpSlotTexel(std::uint32_t slot) { return mortonTexel(slot); }
+inline std::uint32_t hpTexelSlot(glm::ivec2 texel) { return mortonIndex(texel); }
+inline glm::ivec2 hpLiveBox(std::uint64_t count) { return mortonBox(count); }
 // The smallest power-of-two side whose square holds `capacity` slots (at least 1).
 int hpBaseSizeFor(std::uint64_t capacity);
-
-// ---------------------------------------------------------------------------------------------
-// CPU reference.
-
-struct HistoPyramidEntry {
-  std::uint32_t slot = 0;   // source slot (list index)
-  glm::ivec2 texel{0};      // source texel in the base (= hpSlotTexel(slot))
-  std::uint32_t sub = 0;    // sub-index j in [0, count of the source)
-  bool operator==(const HistoPyramidEntry&) const = default;
-};
-
-// The pyramid built on the CPU in exact integers, and the same descent as hpFind.
-class HistoPyramidCpu {
- public:
-  // `counts`: baseSize² values in texel order (x fastest, rows from the bottom: Texture2D data);
-  // only slots < liveSlots count. Throws InputError for a base that is not a power of two, a wrong
-  // number of counts, or a count that is negative, not an integer or not finite (at a live slot).
-  HistoPyramidCpu(int baseSize, std::span<const float> counts, std::size_t liveSlots = HistoPyramidLimits::kAllSlots);
-
-  int baseSize() const { return base_; }
-  int levels() const { return levels_; }  // K = log2(baseSize); the top is level K
-  std::uint64_t total() const { return level_.back()[0]; }
-  // Value of texel `t` at `level` (0 = the masked counts).
-  std::uint64_t at(int level, glm::ivec2 t) const;
-  // Output slot k < total() → its source and sub-index (std::out_of_range for k ≥ total()).
-  HistoPyramidEntry find(std::uint64_t k) const;
-  // find(k) for every k < total().
-  std::vector<HistoPyramidEntry> expand() const;
-
- private:
-  int base_ = 0;
-  int levels_ = 0;
-  std::vector<std::vector<std::uint64_t>> level_;  // level_[l]: (base >> l)² values, texel order
-};
-
-// Plain prefix-sum reference: counts by slot (list order) → for each output k, its source slot and
-// sub-index (texel = hpSlotTexel(slot)). This is what the CPU twin does; it equals
-// HistoPyramidCpu::expand() for the same counts placed at hpSlotTexel.
-std::vector<HistoPyramidEntry> hpExpandByPrefixSum(std::span<const std::uint32_t> countsBySlot);
+// log2 of a base side that is a power of two in [1, kMaxBaseSize]; InputError otherwise.
+int hpCheckedLevels(int baseSize);
 
 // ---------------------------------------------------------------------------------------------
 // GPU pyramid (needs a current GL context for its whole life; destroy it before the context).

@@ -1,15 +1,14 @@
-// Tests of lightsim/histo_pyramid: Morton slots, the CPU reference against a plain prefix sum, and
-// the GPU pyramid (OSMesa) — the total and the traversal of shaders/lightsim/histo_pyramid.glsl
-// checked for every output slot against the CPU reference, for random and edge-case count patterns,
-// live counts that are not powers of two, stale data beyond the live slots, and a producer that
-// renders into the base. Also prints build/traverse times for 512² and 1024².
+// Tests of lightsim/histo_pyramid: Morton slots, and the GPU pyramid (OSMesa) — the total and the
+// traversal of shaders/lightsim/histo_pyramid.glsl checked for every output slot against the CPU
+// reference (histo_pyramid_cpu.h, tested in histo_pyramid_cpu_test.cpp), for random and edge-case
+// count patterns, live counts that are not powers of two, stale data beyond the live slots, and a
+// producer that renders into the base. Also prints build/traverse times for 512² and 1024².
 #include "lightsim/histo_pyramid.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <bit>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -18,32 +17,18 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/stopwatch.h"
 #include "gl/context.h"
 #include "gl/framebuffer.h"
 #include "gl/shader_library.h"
 #include "gl/vertex_array.h"
+#include "lightsim/histo_pyramid_cpu.h"
 
 namespace eik {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-std::size_t texelIndex(glm::ivec2 t, int side) { return std::size_t(t.y) * std::size_t(side) + std::size_t(t.x); }
-
-// Counts in texel order for `live` slots (Morton order) drawn from `values` with `weights`; slots
-// beyond `live` get `beyond`.
-std::vector<float> randomCounts(int side, std::size_t live, const std::vector<float>& values,
-                                const std::vector<double>& weights, std::mt19937& rng, float beyond = 0.0f) {
-  std::discrete_distribution<int> pick(weights.begin(), weights.end());
-  std::vector<float> counts(std::size_t(side) * std::size_t(side), beyond);
-  for (std::size_t s = 0; s < std::min(live, counts.size()); ++s) {
-    counts[texelIndex(hpSlotTexel(std::uint32_t(s)), side)] = values[std::size_t(pick(rng))];
-  }
-  return counts;
-}
-
 // ---------------------------------------------------------------------------------------------
-// Slots and the CPU reference (no GL).
+// Slots (no GL).
 
 TEST(HistoPyramidSlots, MortonRoundTripAndOrder) {
   EXPECT_EQ(hpSlotTexel(0), glm::ivec2(0, 0));
@@ -89,41 +74,6 @@ TEST(HistoPyramidSlots, BaseSizeFor) {
   EXPECT_EQ(hpBaseSizeFor(std::uint64_t{1} << 24), 4096);
 }
 
-TEST(HistoPyramidCpuTest, DescentEqualsPrefixSum) {
-  std::mt19937 rng(7);
-  for (int side : {1, 2, 4, 8, 32}) {
-    const std::size_t n = std::size_t(side) * std::size_t(side);
-    for (std::size_t live : {n, n / 2 + 1, std::size_t(1), n > 3 ? n - 3 : n}) {
-      std::vector<float> counts = randomCounts(side, live, {0, 1, 2, 3, 4}, {3, 3, 1, 1, 2}, rng, 3.0f);
-      HistoPyramidCpu cpu(side, counts, live);
-      std::vector<std::uint32_t> bySlot(live);
-      for (std::size_t s = 0; s < live; ++s) {
-        bySlot[s] = std::uint32_t(counts[texelIndex(hpSlotTexel(std::uint32_t(s)), side)]);
-      }
-      const std::vector<HistoPyramidEntry> reference = hpExpandByPrefixSum(bySlot);
-      EXPECT_EQ(cpu.total(), reference.size());
-      EXPECT_EQ(cpu.expand(), reference) << "side " << side << ", live " << live;
-    }
-  }
-}
-
-TEST(HistoPyramidCpuTest, RejectsBadInput) {
-  std::vector<float> counts(16, 1.0f);
-  EXPECT_THROW(HistoPyramidCpu(3, std::vector<float>(9, 1.0f)), InputError);
-  EXPECT_THROW(HistoPyramidCpu(4, std::vector<float>(15, 1.0f)), InputError);
-  counts[5] = 1.5f;
-  EXPECT_THROW(HistoPyramidCpu(4, counts), InputError);
-  counts[5] = -1.0f;
-  EXPECT_THROW(HistoPyramidCpu(4, counts), InputError);
-  counts[5] = std::numeric_limits<float>::quiet_NaN();
-  EXPECT_THROW(HistoPyramidCpu(4, counts), InputError);
-  // Beyond the live slots anything goes.
-  counts.assign(16, 1.0f);
-  counts[texelIndex(hpSlotTexel(12), 4)] = std::numeric_limits<float>::quiet_NaN();
-  EXPECT_EQ(HistoPyramidCpu(4, counts, 12).total(), 12u);
-  EXPECT_THROW(HistoPyramidCpu(4, counts, 12).find(12), std::out_of_range);
-}
-
 // ---------------------------------------------------------------------------------------------
 // GPU.
 
@@ -157,7 +107,7 @@ class HistoPyramidGl : public ::testing::Test {
     for (int y = 0; y < side; ++y) {
       for (int x = 0; x < side; ++x) {
         const std::uint32_t k = hpTexelSlot({x, y});
-        const float* got = &pixels[texelIndex({x, y}, side) * 4];
+        const float* got = &pixels[hpTexelIndex({x, y}, side) * 4];
         float want[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
         if (k < total) {
           const HistoPyramidEntry e = cpu.find(k);
@@ -201,7 +151,7 @@ class HistoPyramidGl : public ::testing::Test {
       const int side = cpu.baseSize() >> (m + 1);
       const std::uint64_t nodes = std::max<std::uint64_t>((live + (std::uint64_t{1} << (2 * (m + 1))) - 1) >> (2 * (m + 1)), 1);
       for (std::uint64_t s = 0; s < nodes; ++s) {
-        const float* texel = &mips[std::size_t(m)][texelIndex(hpSlotTexel(std::uint32_t(s)), side) * 4];
+        const float* texel = &mips[std::size_t(m)][hpTexelIndex(hpSlotTexel(std::uint32_t(s)), side) * 4];
         for (int i = 0; i < 4; ++i) {
           const glm::ivec2 child = hpSlotTexel(std::uint32_t(4 * s + std::uint64_t(i)));
           ASSERT_EQ(double(texel[i]), double(cpu.at(m, child))) << "mip " << m << " node " << s << " child " << i;
@@ -219,7 +169,7 @@ TEST_F(HistoPyramidGl, RandomPatternsZeroOneFour) {
   };
   for (Case c : {Case{1, 1}, Case{2, 3}, Case{4, 16}, Case{4, 11}, Case{64, 4096}, Case{64, 3001}, Case{256, 65536},
                  Case{256, 50001}}) {
-    checkCase(c.base, randomCounts(c.base, c.live, {0, 1, 4}, {0.3, 0.5, 0.2}, rng), c.live);
+    checkCase(c.base, hpRandomCounts(c.base, c.live, {0, 1, 4}, {0.3, 0.5, 0.2}, rng), c.live);
   }
 }
 
@@ -227,15 +177,15 @@ TEST_F(HistoPyramidGl, RandomPatternsZeroToFour) {
   std::mt19937 rng(99);
   for (int base : {4, 64, 256}) {
     const std::size_t n = std::size_t(base) * std::size_t(base);
-    checkCase(base, randomCounts(base, n, {0, 1, 2, 3, 4}, {2, 2, 1, 1, 1}, rng));
-    checkCase(base, randomCounts(base, n * 2 / 3 + 1, {0, 1, 2, 3, 4}, {2, 2, 1, 1, 1}, rng), n * 2 / 3 + 1, true);
+    checkCase(base, hpRandomCounts(base, n, {0, 1, 2, 3, 4}, {2, 2, 1, 1, 1}, rng));
+    checkCase(base, hpRandomCounts(base, n * 2 / 3 + 1, {0, 1, 2, 3, 4}, {2, 2, 1, 1, 1}, rng), n * 2 / 3 + 1, true);
   }
 }
 
 TEST_F(HistoPyramidGl, SparseAndLargerCounts) {
   std::mt19937 rng(5);
   // Mostly dead, a few larger counts (the pyramid takes any integer count).
-  checkCase(128, randomCounts(128, 128 * 128, {0, 1, 4, 7, 16}, {0.95, 0.02, 0.02, 0.005, 0.005}, rng));
+  checkCase(128, hpRandomCounts(128, 128 * 128, {0, 1, 4, 7, 16}, {0.95, 0.02, 0.02, 0.005, 0.005}, rng));
 }
 
 TEST_F(HistoPyramidGl, AllDead) {
@@ -269,7 +219,7 @@ TEST_F(HistoPyramidGl, CountsOnlyInTheLastRow) {
   std::mt19937 rng(17);
   for (int base : {4, 64, 256}) {
     std::vector<float> counts(std::size_t(base) * std::size_t(base), 0.0f);
-    for (int x = 0; x < base; ++x) counts[texelIndex({x, base - 1}, base)] = float(int(rng() % 5));
+    for (int x = 0; x < base; ++x) counts[hpTexelIndex({x, base - 1}, base)] = float(int(rng() % 5));
     checkCase(base, counts);
   }
 }
@@ -281,7 +231,7 @@ TEST_F(HistoPyramidGl, StaleDataBeyondTheLiveSlotsIsIgnored) {
   const int base = 64;
   const std::size_t n = base * base;
   HistoPyramid pyramid(base, library_);
-  const std::vector<float> first = randomCounts(base, n, {0, 1, 4}, {0.2, 0.5, 0.3}, rng);
+  const std::vector<float> first = hpRandomCounts(base, n, {0, 1, 4}, {0.2, 0.5, 0.3}, rng);
   gl::Texture2D texture({base, base}, gl::TextureFormat::R32F, first, 1,
                         gl::Sampling{gl::Filter::Nearest, gl::Wrap::ClampToEdge});
   pyramid.build(texture);
@@ -290,7 +240,7 @@ TEST_F(HistoPyramidGl, StaleDataBeyondTheLiveSlotsIsIgnored) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   for (std::size_t live : {std::size_t(1000), std::size_t(37), std::size_t(1), std::size_t(0), std::size_t(2049)}) {
     SCOPED_TRACE("live " + std::to_string(live));
-    std::vector<float> counts = randomCounts(base, live, {0, 1, 4}, {0.3, 0.5, 0.2}, rng, nan);
+    std::vector<float> counts = hpRandomCounts(base, live, {0, 1, 4}, {0.3, 0.5, 0.2}, rng, nan);
     texture.upload(counts, 1);
     pyramid.build(texture, live);
     const HistoPyramidCpu cpu(base, counts, live);
@@ -305,7 +255,7 @@ TEST_F(HistoPyramidGl, ProducerRendersIntoTheBase) {
   std::mt19937 rng(11);
   const int base = 128;
   const std::size_t live = 9000;
-  const std::vector<float> counts = randomCounts(base, live, {0, 1, 4}, {0.3, 0.5, 0.2}, rng, 4.0f);
+  const std::vector<float> counts = hpRandomCounts(base, live, {0, 1, 4}, {0.3, 0.5, 0.2}, rng, 4.0f);
   gl::Texture2D source({base, base}, gl::TextureFormat::R32F, counts, 1,
                        gl::Sampling{gl::Filter::Nearest, gl::Wrap::ClampToEdge});
   HistoPyramid pyramid(base, library_);
@@ -357,7 +307,7 @@ TEST(HistoPyramidTiming, BuildAndTraverse) {
   for (int base : {512, 1024}) {
     const std::size_t n = std::size_t(base) * std::size_t(base);
     // A list that mostly survives (mean count 0.95), so the output fits the same side.
-    const std::vector<float> counts = randomCounts(base, n, {0, 1, 4}, {0.25, 0.7, 0.05}, rng);
+    const std::vector<float> counts = hpRandomCounts(base, n, {0, 1, 4}, {0.25, 0.7, 0.05}, rng);
     HistoPyramid pyramid(base, library);
     gl::Texture2D texture({base, base}, gl::TextureFormat::R32F, counts, 1,
                           gl::Sampling{gl::Filter::Nearest, gl::Wrap::ClampToEdge});
@@ -367,14 +317,14 @@ TEST(HistoPyramidTiming, BuildAndTraverse) {
     std::uint64_t total = 0;
     for (int rep = 0; rep < 4; ++rep) {
       glFinish();
-      auto t0 = Clock::now();
+      Stopwatch watch;
       pyramid.build(texture);
       total = pyramid.readTotal();
-      auto t1 = Clock::now();
+      const double buildMs = watch.restart() * 1e3;
       pyramid.build(texture);
       pyramid.requestTotal();  // the asynchronous readback
       (void)pyramid.waitTotal();
-      auto t2 = Clock::now();
+      const double baseBuildMs = watch.restart() * 1e3;
       target.bind();
       const glm::ivec2 box = hpLiveBox(std::min<std::uint64_t>(total, n));
       glViewport(0, 0, box.x, box.y);
@@ -384,10 +334,9 @@ TEST(HistoPyramidTiming, BuildAndTraverse) {
       program.set("uTotal", static_cast<int>(total));
       triangle.draw();
       glFinish();
-      auto t3 = Clock::now();
-      bestBuild = std::min(bestBuild, std::chrono::duration<double, std::milli>(t1 - t0).count());
-      bestBaseBuild = std::min(bestBaseBuild, std::chrono::duration<double, std::milli>(t2 - t1).count());
-      bestTraverse = std::min(bestTraverse, std::chrono::duration<double, std::milli>(t3 - t2).count());
+      bestBuild = std::min(bestBuild, buildMs);
+      bestBaseBuild = std::min(bestBaseBuild, baseBuildMs);
+      bestTraverse = std::min(bestTraverse, watch.milliseconds());
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glUseProgram(0);
@@ -401,7 +350,7 @@ TEST(HistoPyramidTiming, BuildAndTraverse) {
     const std::vector<float> pixels = target.readRGBA(0);
     for (std::uint64_t k : {std::uint64_t{0}, total / 3, total - 1}) {
       const HistoPyramidEntry e = cpu.find(k);
-      const float* got = &pixels[texelIndex(hpSlotTexel(std::uint32_t(k)), base) * 4];
+      const float* got = &pixels[hpTexelIndex(hpSlotTexel(std::uint32_t(k)), base) * 4];
       EXPECT_EQ(got[0], float(e.texel.x));
       EXPECT_EQ(got[1], float(e.texel.y));
       EXPECT_EQ(got[2], float(e.sub));

@@ -1,12 +1,11 @@
-// lightsim: bakes a light's wavefront into a volume (thesis §4, §6.2; DESIGN §4.2; ALGORITHM.md).
+// lightsim: bakes a light's wavefront into a volume (thesis §4, §6.2; docs/programs.md; ALGORITHM.md).
 //
 //   lightsim IN.vol.json -o OUT.vol.json --light directional:DX,DY,DZ | point:X,Y,Z
 //            [--power R,G,B] [--backend gl|cpu] [--deposit accumulate|max] [--stats FILE.json]
 //
-// The work lives in the library (gpu_simulator.h, cpu_simulator.h, bake.h); this file reads the
-// command line, reports progress and writes the outputs.
+// The work lives in the library (make_simulator.h picks the back end; bake.h); this file reads the
+// command line, runs the simulator through its interface, reports progress and writes the outputs.
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -19,36 +18,15 @@
 #include "core/cli.h"
 #include "core/error.h"
 #include "core/progress.h"
-#include "core/scene.h"
+#include "core/stopwatch.h"
 #include "core/volume.h"
 #include "lightsim/bake.h"
-#include "lightsim/cpu_simulator.h"
-#include "lightsim/gpu_simulator.h"
+#include "lightsim/make_simulator.h"
 
 namespace fs = std::filesystem;
 
 namespace eik {
 namespace {
-
-// The first light of a SCENE.json, as a LightSpec.
-LightSpec lightFromScene(const fs::path& file) {
-  Scene scene = readScene(file);
-  if (scene.lights.empty()) throw InputError(file.string(), "lights", "the scene has no light to bake");
-  const SceneLightSpec& l = scene.lights.front();
-  LightSpec light;
-  if (l.type == SceneLightSpec::Type::Directional) {
-    light.type = LightSpec::Type::Directional;
-    light.direction = l.direction;
-    light.power = l.irradiance;
-  } else {
-    light.type = LightSpec::Type::Point;
-    light.position = l.position;
-    light.power = l.intensity;
-  }
-  if (!(light.power.x > 0 || light.power.y > 0 || light.power.z > 0))
-    throw InputError(file.string(), "lights[0]", "the light has no power");
-  return light;
-}
 
 int run(int argc, char** argv) {
   std::string input, output, light_text, power_text = "1,1,1", scene_path, backend = "gl", deposit = "accumulate",
@@ -136,52 +114,29 @@ int run(int argc, char** argv) {
   volume.require("ior", 1, input);
   volume.require("ior_grad", 3, input);
 
-  // --backend auto: probe the OpenGL renderer; a hardware context stays alive for the GPU path.
-  std::unique_ptr<gl::GlContext> probe;
-  if (backend == "auto") {
-    backend = "cpu";
-    try {
-      gl::ContextOptions context;
-      context.backend = gl::parseGlBackend(gl_backend);
-      probe = std::make_unique<gl::GlContext>(context);
-      if (!gl::isSoftwareRenderer(probe->info())) backend = "gl";
-      if (!quiet)
-        std::fprintf(stderr, "lightsim: --backend auto: %s, so the %s\n", probe->info().renderer.c_str(),
-                     backend == "gl" ? "GPU path" : "CPU twin (faster than a software rasterizer)");
-    } catch (const std::exception& e) {
-      if (!quiet) std::fprintf(stderr, "lightsim: --backend auto: no OpenGL context (%s), so the CPU twin\n", e.what());
-    }
-    if (backend == "cpu") probe.reset();
-  }
-  std::unique_ptr<Simulator> simulator;
-  if (backend == "cpu") {
-    simulator = std::make_unique<CpuSimulator>(volume);
-  } else {
-    GpuSimulatorOptions gpu;
-    gpu.source = input;
-    gpu.backend = gl::parseGlBackend(gl_backend);
-    simulator = std::make_unique<GpuSimulator>(volume, gpu);
-  }
+  SimulatorBackendOptions choice;
+  choice.backend = backend == "cpu"    ? SimulatorBackend::Cpu
+                   : backend == "auto" ? SimulatorBackend::Auto
+                                       : SimulatorBackend::Gl;
+  choice.gl = gl_backend;
+  choice.source = input;
+  if (!quiet)
+    choice.report = [](const std::string& why) { std::fprintf(stderr, "lightsim: --backend auto: %s\n", why.c_str()); };
+  const std::unique_ptr<Simulator> simulator = makeSimulator(volume, choice);
   ProgressBar bar("lightsim", !quiet && bench_runs == 0);
   options.progress = bar.callback();
   BakeResult result;
   std::vector<double> seconds;
   for (int run = 0; run < std::max(1, bench_runs); ++run) {
-    const auto t0 = std::chrono::steady_clock::now();
+    const Stopwatch watch;
     result = simulator->run(light, options);
-    seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    seconds.push_back(watch.seconds());
     if (bench_runs > 0 && !quiet)
       std::fprintf(stderr, "lightsim: bench run %d of %d: %.3f s\n", run + 1, bench_runs, seconds.back());
   }
   bar.finish();
   nlohmann::json stats_json = result.stats.toJson();
-  if (const auto* gpu = dynamic_cast<const GpuSimulator*>(simulator.get())) {
-    const GpuRunInfo& info = gpu->lastRunInfo();
-    stats_json["texture_bytes"] = {{"volume", info.volume_bytes},
-                                   {"atlas", info.atlas_bytes},
-                                   {"patch_lists_peak", info.patch_bytes_peak},
-                                   {"total_peak", info.texture_bytes_peak}};
-  }
+  stats_json.update(simulator->lastRunStats());
   if (bench_runs > 0) {
     std::vector<double> sorted = seconds;
     std::sort(sorted.begin(), sorted.end());

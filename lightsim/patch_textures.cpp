@@ -11,40 +11,9 @@
 
 namespace eik {
 
-namespace {
-
-std::uint32_t part1By1(std::uint32_t v) {
-  v &= 0x0000ffffu;
-  v = (v ^ (v << 8)) & 0x00ff00ffu;
-  v = (v ^ (v << 4)) & 0x0f0f0f0fu;
-  v = (v ^ (v << 2)) & 0x33333333u;
-  v = (v ^ (v << 1)) & 0x55555555u;
-  return v;
-}
-
-std::uint32_t compact1By1(std::uint32_t v) {
-  v &= 0x55555555u;
-  v = (v ^ (v >> 1)) & 0x33333333u;
-  v = (v ^ (v >> 2)) & 0x0f0f0f0fu;
-  v = (v ^ (v >> 4)) & 0x00ff00ffu;
-  v = (v ^ (v >> 8)) & 0x0000ffffu;
-  return v;
-}
-
-}  // namespace
-
-glm::ivec2 mortonTexel(std::uint32_t index) {
-  return {static_cast<int>(compact1By1(index)), static_cast<int>(compact1By1(index >> 1))};
-}
-
-std::uint32_t mortonIndex(glm::ivec2 texel) {
-  return part1By1(static_cast<std::uint32_t>(texel.x)) | (part1By1(static_cast<std::uint32_t>(texel.y)) << 1);
-}
-
-glm::ivec2 mortonBox(std::size_t count) {
-  if (count == 0) return {0, 0};
-  const int bits = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(count - 1)));
-  return {1 << ((bits + 1) / 2), 1 << (bits / 2)};
+void viewportLiveBox(std::size_t count) {
+  const glm::ivec2 box = mortonBox(count);
+  glViewport(0, 0, box.x, box.y);
 }
 
 int patchSideFor(std::size_t count, int minimum) {

@@ -31,16 +31,15 @@
 
 #include "gl/framebuffer.h"
 #include "gl/program.h"
+#include "lightsim/morton.h"
 #include "lightsim/wavefront.h"
 
 namespace eik {
 
-// Morton (Z-order) index ↔ texel of the patch list.
-glm::ivec2 mortonTexel(std::uint32_t index);
-std::uint32_t mortonIndex(glm::ivec2 texel);
-// The smallest rectangle at the origin holding texels mortonTexel(0 .. count−1):
-// 2^⌈b/2⌉ × 2^⌊b/2⌋ with b the bit length of count − 1 ((0, 0) for count 0).
-glm::ivec2 mortonBox(std::size_t count);
+// mortonTexel, mortonIndex, mortonBox: lightsim/morton.h.
+// Sets the viewport to mortonBox(count) (after the target's bind() set it to the whole list): the
+// full-screen passes over a list draw only the live patches' box.
+void viewportLiveBox(std::size_t count);
 // The smallest power-of-two side whose square holds `count` patches (at least `minimum`).
 int patchSideFor(std::size_t count, int minimum = 1);
 

@@ -1,7 +1,7 @@
 // The wavefront light simulator (thesis §4.2, §6.2; lightsim/ALGORITHM.md is the specification):
 // one interface, two back ends that are siblings — the GPU particle system (OpenGL 3.3 fragment
 // shaders, gpu_simulator.h) and its CPU twin (cpu_simulator.h), which the tests use to check the
-// GPU path and which serves as a fallback.
+// GPU path and which serves as a fallback. makeSimulator (make_simulator.h) picks one.
 #pragma once
 
 #include <cstdint>
@@ -23,7 +23,7 @@ struct LightSpec {
   glm::dvec3 direction{0.0, -1.0, 0.0};  // directional: unit direction the light travels
   glm::dvec3 position{0.0};              // point
   // Directional: irradiance on a plane facing the light (W/m², RGB). Point: radiant intensity
-  // (W/sr, RGB). DESIGN §4.2 --power.
+  // (W/sr, RGB). docs/programs.md --power.
   glm::dvec3 power{1.0};
   nlohmann::json toJson() const;         // as a SCENE.json light
 };
@@ -80,7 +80,7 @@ struct SimulationStats {
   nlohmann::json toJson() const;
 };
 
-// What a bake adds to a volume (DESIGN §4.1).
+// What a bake adds to a volume (docs/volume-format.md).
 struct BakeResult {
   Field irradiance;   // 3 components, W/m²
   Field light_dir;    // 3 components, unit (0 where no light passed)
@@ -92,6 +92,9 @@ class Simulator {
   virtual ~Simulator() = default;
   // Propagates the light's wavefront through the volume given at construction.
   virtual BakeResult run(const LightSpec& light, const SimulationOptions& options) = 0;
+  // Figures of the last run that SimulationStats has no field for, as members to add to the
+  // statistics JSON (`lightsim --stats`, --bench): GpuSimulator's "texture_bytes"; none here.
+  virtual nlohmann::json lastRunStats() const { return nlohmann::json::object(); }
 };
 
 }  // namespace eik

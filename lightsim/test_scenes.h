@@ -1,6 +1,7 @@
-// Small in-memory scenes for the light simulator's tests (CPU and GPU): procedural volumes built
-// with the voxelize library, and helpers that read the bake back (irradiance on a line, planar
-// flux through a layer of voxels).
+// The shared scaffolding of the light simulator's tests (CPU and GPU): small in-memory scenes
+// (procedural volumes built with the voxelize library, uniform media), helpers that read the bake
+// back (a voxel's value, planar flux through a layer of voxels), and the one GL context the GPU
+// tests share.
 //
 // Header-only on purpose: lightsim/CMakeLists.txt globs every lightsim/*.cpp that is not a test
 // into eikonal_lightsim, which does not link eikonal_voxelize; only the test binary does. Tests
@@ -8,6 +9,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,6 +18,17 @@
 
 #include "core/grid.h"
 #include "core/volume.h"
+#include "gl/context.h"
+#include "gl/shader_library.h"
+#include "gl/volume_textures.h"
+#include "lightsim/analysis_pass.h"
+#include "lightsim/atlas.h"
+#include "lightsim/cpu_simulator.h"
+#include "lightsim/grid_uniforms.h"
+#include "lightsim/patch_textures.h"
+#include "lightsim/step_targets.h"
+#include "lightsim/step_uniforms.h"
+#include "lightsim/update_pass.h"
 #include "lightsim/wavefront.h"
 #include "voxelize/grid_builder.h"
 #include "voxelize/pipeline.h"
@@ -23,7 +36,19 @@
 
 namespace eik::test_scenes {
 
-// The pre-smoothing every scene here assumes unless it says otherwise (DESIGN §5: tests state the
+// One headless context for the whole test program (OSMesa, or EGL when EIKONAL_GL says so), made
+// current. It is never destroyed: GL objects of any test may outlive their test.
+inline gl::GlContext& glContext() {
+  static gl::GlContext* ctx = [] {
+    gl::ContextOptions options;
+    options.backend = gl::glBackendFromEnvironment(gl::GlBackend::Auto);
+    return new gl::GlContext(options);
+  }();
+  ctx->makeCurrent();
+  return *ctx;
+}
+
+// The pre-smoothing every scene here assumes unless it says otherwise (docs/physics.md: tests state the
 // σ they assume): the voxelizer's default, 0.75 voxel.
 constexpr double kSmoothSigmaVoxels = 0.75;
 
@@ -69,6 +94,15 @@ inline Volume uniformVolume(const GridSpec& grid, double n, const glm::dvec3& si
   return v;
 }
 
+// A grid of `dims` voxels of edge h over origin + [0, dims]·h.
+inline GridSpec boxGrid(glm::ivec3 dims, double h, const glm::dvec3& origin = glm::dvec3(0.0)) {
+  GridSpec g;
+  g.dims = dims;
+  g.bounds_min = origin;
+  g.bounds_max = origin + glm::dvec3(dims) * h;
+  return g;
+}
+
 inline GridSpec cubicGrid(int res, double half) {
   GridSpec g;
   g.dims = glm::ivec3(res);
@@ -109,7 +143,113 @@ inline Volume absorbingSphere(int res, const Bounds& bounds, double r, double si
 }
 
 // ---------------------------------------------------------------------------------------------
+// The GPU tests' scene, and a patch list in mid-flight through it.
+
+// The small glass-sphere scene of the GPU comparisons: n = 1.5, r = 0.5 on `res` voxels (+3 of
+// air), σ = 0.75 voxel pre-smoothing (the voxelizer's default); `extra` is appended to the spec
+// (",sigma_a=0.5:1:2").
+inline Volume gpuGlassSphere(int res = 32, const std::string& extra = "") {
+  return proceduralVolume("procedural:sphere,r=0.5,ior=1.5" + extra, res);
+}
+
+// Fewer splits than the default (max_depth 4), so each GPU bake takes seconds on llvmpipe.
+inline SimulationOptions gpuTestOptions() {
+  SimulationOptions o;
+  o.max_depth = 4;
+  return o;
+}
+
+// One step of the CPU twin on a list (stepPatch, then compaction and expansion by prefix sum).
+// `splits` counts the splits by their number of children (index 2: 1×2, index 4: 2×2).
+inline std::vector<Patch> cpuStep(const std::vector<Patch>& patches, const StepContext& ctx,
+                           std::array<int, 5>* splits = nullptr) {
+  std::vector<Patch> next;
+  for (Patch p : patches) {
+    const PatchStepResult r = stepPatch(p, ctx);
+    if (r.fate == PatchFate::Keep) next.push_back(p);
+    if (r.fate == PatchFate::Split) {
+      if (splits) ++(*splits)[static_cast<std::size_t>(r.split.count())];
+      std::array<Patch, 4> children;
+      const int count = splitPatch(p, *ctx.sampler, r.split, children);
+      next.insert(next.end(), children.begin(), children.begin() + count);
+    }
+  }
+  return next;
+}
+
+// A list taken mid-flight: 45 steps of the CPU twin into the absorbing glass sphere (24 voxels,
+// σa = 0.5, 1, 2), lit along (0.3, −1, 0.2), with gpuTestOptions() and `rule` — patches in the
+// boundary layer, inside the glass, splitting. The patches are rounded to float (packPatch), so
+// that a GPU pass and the twin start from the same numbers. Not copyable: ctx points into it.
+struct MidFlightList {
+  Volume volume;
+  VolumeSampler sampler;
+  SimulationOptions options;
+  double fluxRef = 0.0;
+  StepContext ctx;
+  std::vector<Patch> patches;
+
+  explicit MidFlightList(SplitRule rule = SplitRule::Axis)
+      : volume(gpuGlassSphere(24, ",sigma_a=0.5:1:2")), sampler(volume), options(gpuTestOptions()) {
+    options.split_rule = rule;
+    LightSpec light;
+    light.direction = glm::normalize(glm::dvec3(0.3, -1.0, 0.2));
+    patches = initialPatches(light, volume.grid, sampler, options, &fluxRef);
+    ctx = StepContext{&sampler, &options, timeStep(volume.grid, options), fluxRef, volume.grid.voxelVolume()};
+    for (int i = 0; i < 45; ++i) patches = cpuStep(patches, ctx);
+    // Round to float first, so both sides start from the same numbers.
+    for (Patch& p : patches) p = unpackPatch(packPatch(p));
+  }
+  MidFlightList(const MidFlightList&) = delete;
+  MidFlightList& operator=(const MidFlightList&) = delete;
+};
+
+// The GPU passes of one step on a MidFlightList's patches, set up as GpuSimulator does it (but in
+// world coordinates): the volume uploaded, the run's uniforms, the list uploaded into `a` (of a
+// side that holds `capacity` patches, and at least the list), `b` and the step targets. update()
+// and analyse() run those passes in the simulator's order (a → b, then b with a as the list before).
+struct GpuStep {
+  gl::GlContext& gl = glContext();  // first: everything below needs it current
+  gl::ShaderLibrary library;
+  gl::VolumeTextures textures;
+  std::string defines;
+  AtlasLayout atlas;
+  gpu::GridUniforms grid;
+  gpu::StepUniforms step;
+  std::size_t count;
+  PatchTextures a, b;
+  gpu::StepTargets targets;
+
+  explicit GpuStep(const MidFlightList& list, std::size_t capacity = 0)
+      : textures(list.volume),
+        defines(textures.layout().glslDefines()),
+        atlas(AtlasLayout::plan(list.volume.grid.dims, gl.info().maxTextureSize)),
+        grid(gpu::GridUniforms::from(list.volume.grid)),
+        step(gpu::StepUniforms::from(list.volume.grid, list.options, list.fluxRef)),
+        count(list.patches.size()),
+        a(patchSideFor(std::max(count, capacity))),
+        b(a.side()),
+        targets(a.side(), library) {
+    std::vector<PatchTexels> packed;
+    for (const Patch& p : list.patches) packed.push_back(packPatch(p));
+    a.upload(packed);
+  }
+
+  void update(Integrator integrator) {
+    gpu::UpdatePass(library, integrator, defines).run(a, b, count, textures, grid, step);
+  }
+  void analyse(DepositMode mode) {
+    gpu::AnalysisPass(library, mode, atlas, defines).run(b, a, count, targets, textures, grid, step);
+  }
+};
+
+// ---------------------------------------------------------------------------------------------
 // Reading a bake.
+
+// The RGB value of voxel `i` (flat index) of a 3-component field.
+inline glm::dvec3 voxelValue(const Field& f, std::size_t i) {
+  return {f.data[i * 3], f.data[i * 3 + 1], f.data[i * 3 + 2]};
+}
 
 inline glm::dvec3 voxelValue(const Field& f, const GridSpec& g, int i, int j, int k) {
   const float* p = f.voxel(g.index(i, j, k));

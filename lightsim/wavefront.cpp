@@ -215,7 +215,7 @@ std::array<Patch, 4> splitPatch(const Patch& parent, const VolumeSampler& sample
 }
 
 // ---------------------------------------------------------------------------------------------
-// Fresnel (seeds/README.md)
+// Fresnel (the corrected thesis Eq. 3.6; docs/physics.md)
 
 double fresnelReflectance(double n1, double n2, double cos_i) {
   cos_i = std::min(std::fabs(cos_i), 1.0);

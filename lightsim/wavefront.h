@@ -6,7 +6,7 @@
 //  - VolumeSampler: n, ∇n and σa sampled exactly like GL texture() ("Units and inputs");
 //  - initialPatches: directional and point lights ("Initialisation", thesis §6.2.1);
 //  - splitPatch: the 2×2 bilinear split ("One step", 6; Fig. 4.3);
-//  - fresnelReflectance (seeds/README.md), ray–box tests and the run's constants.
+//  - fresnelReflectance (the corrected thesis Eq. 3.6), ray–box tests and the run's constants.
 //
 // Everything here is double precision. The GPU stores the same quantities in float, so the two
 // agree to float rounding, not bit for bit.
@@ -159,8 +159,9 @@ inline glm::dvec3 renormalised(const glm::dvec3& w, double n) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Fresnel (seeds/README.md, corrected Eq. 3.6): unpolarised reflectance R = (Rs + Rp)/2 for light
-// going from index n1 into n2 at incidence cos θᵢ (|cos_i| is used), 1 beyond the critical angle.
+// Fresnel (the corrected thesis Eq. 3.6; docs/physics.md): unpolarised reflectance
+// R = (Rs + Rp)/2 for light going from index n1 into n2 at incidence cos θᵢ (|cos_i| is used), 1
+// beyond the critical angle.
 double fresnelReflectance(double n1, double n2, double cos_i);
 
 // The reflectance a patch gets on leaving a boundary layer (ALGORITHM.md step 3, with two

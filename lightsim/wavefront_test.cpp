@@ -262,7 +262,7 @@ TEST(Split, AxisRuleHalvesOnlyTheLongDirection) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Fresnel (seeds/README.md)
+// Fresnel (the corrected thesis Eq. 3.6; docs/physics.md)
 
 TEST(Fresnel, NormalIncidence) {
   EXPECT_NEAR(fresnelReflectance(1.0, 1.5, 1.0), 0.04, 1e-15);

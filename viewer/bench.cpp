@@ -1,10 +1,10 @@
 #include "viewer/bench.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 
+#include "core/stopwatch.h"
 #include "gl/framebuffer.h"
 #include "viewer/scene_renderer.h"
 
@@ -21,7 +21,6 @@ double medianOf(std::vector<double> values) {
 }
 
 std::vector<double> timeFrames(const std::function<void()>& draw, int frames, bool warm_up) {
-  using Clock = std::chrono::steady_clock;
   glFinish();  // nothing earlier in the timings
   if (warm_up) {
     draw();  // shader compilation, first texture use
@@ -30,10 +29,10 @@ std::vector<double> timeFrames(const std::function<void()>& draw, int frames, bo
   std::vector<double> ms;
   ms.reserve(static_cast<std::size_t>(std::max(frames, 0)));
   for (int i = 0; i < frames; ++i) {
-    const auto start = Clock::now();
+    const Stopwatch frame_clock;
     draw();
     glFinish();
-    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+    ms.push_back(frame_clock.milliseconds());
   }
   return ms;
 }

@@ -1,4 +1,4 @@
-// `viewer --bench N` (DESIGN §4.2, §6 "timings belong in benchmarks"): N frames of the full
+// `viewer --bench N` (docs/programs.md, docs/testing.md "timings belong in benchmarks"): N frames of the full
 // renderer headless, and N frames of a bare refractive march of the same volume (BareMarch, the
 // cost floor of curved-ray casting: Euler steps with ONE fetch a step of a packed n+∇n texture,
 // no shading), each frame ended by glFinish, the median ms/frame of each, and their ratio.

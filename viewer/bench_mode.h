@@ -21,7 +21,7 @@ struct BenchOptions {
   bool quiet = false;
 };
 
-// Returns the exit code (0). The bare march runs on the first object only (DESIGN §6.3 scenes for
+// Returns the exit code (0). The bare march runs on the first object only (docs/testing.md scenes for
 // the benchmark hold one volume).
 int runBenchMode(const LoadedScene& scene, const RenderSettings& settings, const Camera& camera,
                  const BenchOptions& options);

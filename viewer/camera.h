@@ -1,4 +1,4 @@
-// A pinhole camera (DESIGN §4.3 "camera"): eye, target, up, vertical field of view.
+// A pinhole camera (docs/scene-format.md "camera"): eye, target, up, vertical field of view.
 #pragma once
 
 #include <string>
@@ -22,7 +22,7 @@ struct Camera {
   glm::dmat4 inverseViewProjection(double aspect) const;
 };
 
-// "EX,EY,EZ:TX,TY,TZ:FOVY_DEG" (the --camera flag, DESIGN §4.2); InputError naming `source`.
+// "EX,EY,EZ:TX,TY,TZ:FOVY_DEG" (the --camera flag, docs/programs.md); InputError naming `source`.
 Camera parseCamera(const std::string& text, const std::string& source = "--camera");
 
 }  // namespace eik

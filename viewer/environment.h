@@ -1,6 +1,6 @@
 // The environment: the radiance arriving from infinitely far away in each direction, seen where a
 // viewing ray leaves every volume (thesis Eq. 5.10, the L(x_e) term) and in reflections.
-// Kinds (DESIGN §4.3 "environment"):
+// Kinds (docs/scene-format.md "environment"):
 //   uniform      {"uniform": [r, g, b]}
 //   map          {"file": "sky.exr", "intensity": 1, "rotate_deg": 0}: an equirectangular
 //                (latitude/longitude) HDR/EXR/PNG, read through OpenImageIO and mipmapped; rays

@@ -1,4 +1,4 @@
-// A scene ready to render: the SCENE.json (core/scene.h, DESIGN §4.3) and every object's volume
+// A scene ready to render: the SCENE.json (core/scene.h, docs/scene-format.md) and every object's volume
 // read from disk, placed by its transform. A bare VOLUME.vol.json is a scene too: that volume at
 // the origin, a camera framing it, a white environment and the light it was baked with.
 #pragma once
@@ -30,7 +30,7 @@ struct LoadedScene {
   Camera camera() const { return Camera::fromSpec(scene.camera); }
 };
 
-// The object's placement: translate · Rz · Ry · Rx · scale (DESIGN §4.3).
+// The object's placement: translate · Rz · Ry · Rx · scale (docs/scene-format.md).
 glm::dmat4 objectToWorld(const SceneObjectSpec& object);
 
 // A camera looking at the box from the front and a little above, the whole box in view.

@@ -1,4 +1,4 @@
-// viewer: renders refractive volumes along curved rays (thesis §5, §6.3; DESIGN §4.2).
+// viewer: renders refractive volumes along curved rays (thesis §5, §6.3; docs/programs.md).
 //
 //   viewer SCENE.json | VOLUME.vol.json [--render OUT.exr|OUT.png] [--size WxH]
 //          [--camera EX,EY,EZ:TX,TY,TZ:FOVY_DEG] [--env FILE | uniform:R,G,B | checker[:R,G,B] | sky]

@@ -1,17 +1,14 @@
 #include "viewer/render_settings.h"
 
-#include <algorithm>
-#include <cctype>
-
 #include "core/error.h"
+#include "core/text.h"
 
 namespace eik {
 
 RayIntegrator parseRayIntegrator(const std::string& text, const std::string& source) {
-  std::string lower = text;
-  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (lower == "euler") return RayIntegrator::Euler;
-  if (lower == "rk4") return RayIntegrator::RK4;
+  const std::string name = lower(text);
+  if (name == "euler") return RayIntegrator::Euler;
+  if (name == "rk4") return RayIntegrator::RK4;
   throw InputError(source, text, "expected euler or rk4");
 }
 

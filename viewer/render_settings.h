@@ -7,7 +7,7 @@
 
 namespace eik {
 
-// How a viewing ray is advanced along the ray equation (Eq. 5.11/5.12, DESIGN §5).
+// How a viewing ray is advanced along the ray equation (Eq. 5.11/5.12, docs/physics.md).
 enum class RayIntegrator {
   Euler,  // one ∇n fetch a step, |w| renormalised to n
   RK4,    // classical Runge–Kutta, four ∇n fetches a step
@@ -40,7 +40,7 @@ struct RenderSettings {
   // scenes measured (64³ glass sphere 1.11× → 1.16× the bare march; 32³ absorbing one 2.2× → 2.8×).
   bool homogeneous_bricks = false;
   // A ray enters a boundary layer where |∇n|·h exceeds this (h: the voxel size) and leaves it where
-  // |∇n|·h falls below a quarter of it; Fresnel is evaluated with n before and after the layer.
+  // |∇n|·h falls below a 16th of it; Fresnel is evaluated with n before and after the layer.
   double boundary_threshold = 0.02;
   // Rays stop once every channel's transmittance is below this (early termination).
   double min_transmittance = 1e-3;

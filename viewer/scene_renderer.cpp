@@ -1,8 +1,8 @@
+// The renderer of viewer/scene_renderer.h: uploads, program variants, uniforms, the draw.
 #include "viewer/scene_renderer.h"
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -13,146 +13,10 @@
 #include "gl/vertex_array.h"
 #include "gl/volume_textures.h"
 #include "viewer/environment.h"
+#include "viewer/raymarch_shader.h"
+#include "viewer/volume_analysis.h"
 
 namespace eik {
-namespace {
-
-constexpr int kMaxLights = 8;
-constexpr const char* kObjectsMarker = "// @OBJECTS@";
-
-// The box (in the volume's own coordinates) of the voxels where something happens: n ≠ 1, ∇n ≠ 0,
-// absorption, emission, scattering or an opaque embedding; one voxel of margin for the trilinear
-// filter. Outside it a ray goes straight and gathers nothing (empty-space skipping). Returns false
-// when the volume is empty throughout.
-bool activeRegion(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi) {
-  const GridSpec& grid = volume.grid;
-  const glm::ivec3 dims = grid.dims;
-  glm::ivec3 imin(dims), imax(-1);
-  auto mark = [&](std::size_t index) {
-    const int x = static_cast<int>(index % static_cast<std::size_t>(dims.x));
-    const int y = static_cast<int>((index / static_cast<std::size_t>(dims.x)) % static_cast<std::size_t>(dims.y));
-    const int z = static_cast<int>(index / (static_cast<std::size_t>(dims.x) * static_cast<std::size_t>(dims.y)));
-    imin = glm::min(imin, glm::ivec3(x, y, z));
-    imax = glm::max(imax, glm::ivec3(x, y, z));
-  };
-  const std::size_t count = grid.count();
-  const double h = std::min({grid.voxelSize().x, grid.voxelSize().y, grid.voxelSize().z});
-  auto scan = [&](const char* name, auto&& nontrivial) {
-    const Field* f = volume.find(name);
-    if (!f) return;
-    for (std::size_t i = 0; i < count; ++i)
-      if (nontrivial(f->voxel(i))) mark(i);
-  };
-  scan("ior", [](const float* v) { return std::abs(v[0] - 1.0f) > 1e-5f; });
-  scan("ior_grad", [&](const float* v) { return (std::abs(v[0]) + std::abs(v[1]) + std::abs(v[2])) * h > 1e-6; });
-  scan("sigma_a", [](const float* v) { return v[0] > 0 || v[1] > 0 || v[2] > 0; });
-  scan("emission", [](const float* v) { return v[0] > 0 || v[1] > 0 || v[2] > 0; });
-  scan("scatter", [](const float* v) { return v[0] > 0; });
-  scan("opaque", [](const float* v) { return v[3] > 0; });
-  if (imax.x < 0) return false;
-  const glm::dvec3 voxel = grid.voxelSize();
-  lo = glm::max(grid.bounds_min, grid.bounds_min + glm::dvec3(imin - 1) * voxel);
-  hi = glm::min(grid.bounds_max, grid.bounds_min + glm::dvec3(imax + 2) * voxel);
-  return true;
-}
-
-// Bricks of kBrickVoxels³ voxels where the medium is homogeneous: n constant and ∇n ≈ 0, σa
-// constant, no emission, scattering or opaque embedding, over the brick and kBrickMargin voxels
-// around it (the trilinear filter and the last step's reach). A ray crossing such a brick goes
-// straight, with T·exp(−σa·L): it crosses it in one step (thesis §6.3 leaves the step size free;
-// DESIGN asks for skipping the interior of homogeneous glass). 1 = homogeneous, 0 = march.
-constexpr int kBrickVoxels = 4;
-constexpr int kBrickMargin = 2;
-
-std::vector<float> homogeneousBricks(const Volume& volume, glm::ivec3& brick_dims) {
-  const GridSpec& grid = volume.grid;
-  const glm::ivec3 dims = grid.dims;
-  brick_dims = (dims + kBrickVoxels - 1) / kBrickVoxels;
-  const double h = std::min({grid.voxelSize().x, grid.voxelSize().y, grid.voxelSize().z});
-  const Field* ior = volume.find("ior");
-  const Field* grad = volume.find("ior_grad");
-  const Field* sigma = volume.find("sigma_a");
-  const Field* emission = volume.find("emission");
-  const Field* scatter = volume.find("scatter");
-  const Field* opaque = volume.find("opaque");
-  // Per voxel: does it break homogeneity by itself (∇n, emission, scattering, opaque)?
-  std::vector<unsigned char> busy(grid.count(), 0);
-  for (std::size_t i = 0; i < grid.count(); ++i) {
-    const float* g = grad->voxel(i);
-    bool b = (std::abs(g[0]) + std::abs(g[1]) + std::abs(g[2])) * h > 1e-4;
-    if (emission) b = b || emission->voxel(i)[0] > 0 || emission->voxel(i)[1] > 0 || emission->voxel(i)[2] > 0;
-    if (scatter) b = b || scatter->voxel(i)[0] > 0;
-    if (opaque) b = b || opaque->voxel(i)[3] > 0;
-    busy[i] = b;
-  }
-  std::vector<float> bricks(static_cast<std::size_t>(brick_dims.x) * brick_dims.y * brick_dims.z, 0.0f);
-  for (int bz = 0; bz < brick_dims.z; ++bz)
-    for (int by = 0; by < brick_dims.y; ++by)
-      for (int bx = 0; bx < brick_dims.x; ++bx) {
-        const glm::ivec3 lo = glm::max(glm::ivec3(bx, by, bz) * kBrickVoxels - kBrickMargin, glm::ivec3(0));
-        const glm::ivec3 hi = glm::min(glm::ivec3(bx, by, bz) * kBrickVoxels + kBrickVoxels + kBrickMargin, dims) - 1;
-        const std::size_t first = grid.index(lo.x, lo.y, lo.z);
-        bool homogeneous = true;
-        for (int k = lo.z; k <= hi.z && homogeneous; ++k)
-          for (int j = lo.y; j <= hi.y && homogeneous; ++j)
-            for (int i = lo.x; i <= hi.x && homogeneous; ++i) {
-              const std::size_t v = grid.index(i, j, k);
-              if (busy[v] || std::abs(ior->data[v] - ior->data[first]) > 1e-4f) homogeneous = false;
-              if (sigma)
-                for (int c = 0; c < 3; ++c)
-                  if (std::abs(sigma->voxel(v)[c] - sigma->voxel(first)[c]) > 1e-6f * (1.0f + sigma->voxel(first)[c]))
-                    homogeneous = false;
-            }
-        bricks[(static_cast<std::size_t>(bz) * brick_dims.y + by) * brick_dims.x + bx] = homogeneous ? 1.0f : 0.0f;
-      }
-  return bricks;
-}
-
-// The box (volume coordinates) of the voxels with σa > 0, one voxel of margin; false when none.
-// Rays fetch σa only inside it (a second texture fetch a step is what absorption costs).
-// Whether the material touches the box: n ≠ 1 in a voxel of one of its faces. Such faces are sharp
-// interfaces (object.glsl, SHARP_FACES), as smoothing never saw the air beyond them.
-bool materialTouchesBox(const Volume& volume) {
-  const GridSpec& grid = volume.grid;
-  const Field* ior = volume.find("ior");
-  for (int k = 0; k < grid.dims.z; ++k)
-    for (int j = 0; j < grid.dims.y; ++j)
-      for (int i = 0; i < grid.dims.x; ++i) {
-        const bool face = i == 0 || j == 0 || k == 0 || i == grid.dims.x - 1 || j == grid.dims.y - 1 ||
-                          k == grid.dims.z - 1;
-        if (face && std::abs(ior->data[grid.index(i, j, k)] - 1.0f) > 1e-3f) return true;
-      }
-  return false;
-}
-
-bool absorbingRegion(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi) {
-  const Field* sigma = volume.find("sigma_a");
-  if (!sigma) return false;
-  const GridSpec& grid = volume.grid;
-  glm::ivec3 imin(grid.dims), imax(-1);
-  for (int k = 0; k < grid.dims.z; ++k)
-    for (int j = 0; j < grid.dims.y; ++j)
-      for (int i = 0; i < grid.dims.x; ++i) {
-        const float* v = sigma->voxel(grid.index(i, j, k));
-        if (v[0] > 0 || v[1] > 0 || v[2] > 0) {
-          imin = glm::min(imin, glm::ivec3(i, j, k));
-          imax = glm::max(imax, glm::ivec3(i, j, k));
-        }
-      }
-  if (imax.x < 0) return false;
-  const glm::dvec3 voxel = grid.voxelSize();
-  lo = glm::max(grid.bounds_min, grid.bounds_min + glm::dvec3(imin - 1) * voxel);
-  hi = glm::min(grid.bounds_max, grid.bounds_min + glm::dvec3(imax + 2) * voxel);
-  return true;
-}
-
-std::string replaceAll(std::string text, const std::string& from, const std::string& to) {
-  for (std::size_t pos = 0; (pos = text.find(from, pos)) != std::string::npos; pos += to.size())
-    text.replace(pos, from.size(), to);
-  return text;
-}
-
-}  // namespace
 
 struct SceneRenderer::Impl {
   struct Object {
@@ -184,71 +48,13 @@ struct SceneRenderer::Impl {
       : shaders(library), scene(loaded.scene), environment(loaded.scene.environment, loaded.scene.base_dir, loaded.source) {}
 
   gl::ShaderDefines defines() const {
-    gl::ShaderDefines d;
-    d.emplace_back("OBJECT_COUNT", std::to_string(objects.size()));
-    d.emplace_back("MAX_SEGMENTS", std::to_string(2 * objects.size() + 1));
-    d.emplace_back("LIGHT_COUNT", std::to_string(std::min<std::size_t>(scene.lights.size(), kMaxLights)));
-    if (settings.ground && scene.ground) d.emplace_back("GROUND", "1");
-    if (settings.fresnel) d.emplace_back("FRESNEL", "1");
-    if (settings.attenuation) d.emplace_back("ATTENUATION", "1");
-    if (settings.emission) d.emplace_back("EMISSION", "1");
-    if (settings.scattering) d.emplace_back("SCATTERING", "1");
-    if (!settings.refraction) d.emplace_back("NO_REFRACTION", "1");
-    if (settings.integrator == RayIntegrator::RK4) d.emplace_back("RK4", "1");
-    if (settings.homogeneous_bricks) d.emplace_back("SKIP_HOMOGENEOUS", "1");
-    const bool dispersive = std::any_of(objects.begin(), objects.end(), [](const Object& o) { return o.has_dispersion; });
-    if (settings.output == RenderOutput::ExitPosition) d.emplace_back("OUTPUT_EXIT_POSITION", "1");
-    else if (settings.output == RenderOutput::ExitDirection) d.emplace_back("OUTPUT_EXIT_DIRECTION", "1");
-    else if (settings.dispersion && dispersive) d.emplace_back("DISPERSION", "1");
-    for (const auto& e : environment.defines()) d.push_back(e);
-    return d;
-  }
-
-  // raymarch.frag with its "// @OBJECTS@" line replaced by one instance of object.glsl per object
-  // (each inside its own volume layout's #defines) and the dispatch functions.
-  gl::ShaderSource fragmentSource(const gl::ShaderDefines& defs) const {
-    gl::ShaderSource source = shaders.source("viewer/raymarch.frag", defs);
-    const std::string main_text = shaders.read("viewer/raymarch.frag");
-    const std::size_t marker_in_main = main_text.find(kObjectsMarker);
-    const std::size_t marker = source.text.find(kObjectsMarker);
-    if (marker == std::string::npos || marker_in_main == std::string::npos)
-      throw RuntimeError("viewer/raymarch.frag has no '" + std::string(kObjectsMarker) + "' line");
-    const int marker_line = 1 + static_cast<int>(std::count(main_text.begin(), main_text.begin() + marker_in_main, '\n'));
-    const std::string object_template = shaders.read("viewer/object.glsl");
-
-    std::ostringstream out;
-    for (std::size_t k = 0; k < objects.size(); ++k) {
-      const std::string index = std::to_string(k);
-      const gl::VolumeTextureLayout& layout = objects[k].textures.layout();
-      std::string layout_defines =
-          replaceAll(layout.glslDefines(), "uVolumeTex", "uO" + index + "Tex");
-      std::vector<std::string> names;
-      std::istringstream lines(layout_defines);
-      for (std::string line; std::getline(lines, line);) {
-        std::istringstream words(line);
-        std::string directive, name;
-        if (words >> directive >> name && directive == "#define") names.push_back(name);
-      }
-      if (objects[k].sharp_faces) layout_defines += "#define SHARP_FACES 1\n";
-      out << layout_defines << "\n";
-      for (int t = 0; t < layout.textureCount(); ++t) out << "uniform sampler3D uO" << index << "Tex" << t << ";\n";
-      out << "uniform sampler3D uO" << index << "Bricks;\n";
-      out << "#line 1 " << source.files.size() << "\n";
-      out << replaceAll(object_template, "@", index) << "\n";
-      for (const std::string& name : names) out << "#undef " << name << "\n";
-      source.files.push_back("viewer/object.glsl (object " + index + ")");
-    }
-    out << "void marchObject(int k, inout Ray r, float cauchy) {\n";
-    for (std::size_t k = 0; k < objects.size(); ++k)
-      out << "  " << (k ? "else " : "") << "if (k == " << k << ") march" << k << "(r, cauchy);\n";
-    out << "}\n#ifdef GROUND\nfloat bakedGroundIrradiance(vec3 xw, out vec3 E) {\n  float weight;\n";
-    for (std::size_t k = 0; k < objects.size(); ++k)
-      out << "  weight = bakedGroundIrradiance" << k << "(xw, E);\n  if (weight > 0.0) return weight;\n";
-    out << "  E = vec3(0.0);\n  return 0.0;\n}\n#endif\n";
-    out << "#line " << marker_line + 1 << " 0\n";
-    const std::size_t line_end = source.text.find('\n', marker);
-    source.text.replace(marker, line_end - marker, out.str());
-    return source;
+    RaymarchScene variant;
+    variant.objects = objects.size();
+    variant.lights = scene.lights.size();
+    variant.ground = scene.ground.has_value();
+    variant.dispersive = std::any_of(objects.begin(), objects.end(), [](const Object& o) { return o.has_dispersion; });
+    variant.environment = environment.defines();
+    return raymarchDefines(settings, variant);
   }
 
   void buildProgram() {
@@ -256,8 +62,10 @@ struct SceneRenderer::Impl {
     std::string key;
     for (const auto& [name, value] : defs) key += name + "=" + value + ";";
     if (program && key == program_key) return;
+    std::vector<RaymarchObject> shapes;
+    for (const Object& o : objects) shapes.push_back({o.textures.layout(), o.sharp_faces});
     gl::ShaderSource vertex = shaders.source("common/fullscreen.vert");
-    program = gl::Program(vertex, fragmentSource(defs));
+    program = gl::Program(vertex, raymarchFragmentSource(shaders, defs, shapes));
     program_key = key;
   }
 
@@ -295,11 +103,11 @@ struct SceneRenderer::Impl {
       p.set("uObjBoundaryGrad" + i, static_cast<float>(settings.boundary_threshold / h));
       for (int t = 0; t < o.textures.layout().textureCount(); ++t) {
         o.textures.texture(t).bind(unit);
-        p.setSampler("uO" + std::to_string(k) + "Tex" + std::to_string(t), unit);
+        p.setSampler(objectTextureSampler(k, t), unit);
         ++unit;
       }
       o.bricks.bind(unit);
-      p.setSampler("uO" + std::to_string(k) + "Bricks", unit);
+      p.setSampler(objectBricksSampler(k), unit);
       ++unit;
       p.set("uObjBrickSize" + i, glm::vec3(o.grid.extent() / glm::dvec3(o.grid.dims) * double(kBrickVoxels)));
     }

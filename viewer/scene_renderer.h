@@ -8,6 +8,8 @@
 // (viewer/environment.h). Output is linear HDR radiance; tone mapping is the caller's.
 // Where a volume's material touches its box, the faces are sharp interfaces (Snell, Fresnel).
 // Limit: objects' boxes should not overlap (a ray marches one box at a time).
+// The shader is assembled by viewer/raymarch_shader.h, from what viewer/volume_analysis.h finds in
+// each volume; viewer/IMAGE_FORMATION.md maps each equation to its code.
 #pragma once
 
 #include <memory>

@@ -1,4 +1,4 @@
-// The viewer's image formation against analytic answers (thesis §5, DESIGN §6): Beer–Lambert with
+// The viewer's image formation against analytic answers (thesis §5, docs/testing.md): Beer–Lambert with
 // Fresnel at normal incidence, Fresnel reflectance at several angles, total internal reflection,
 // Snell's lateral shift through a tilted slab, a ball lens inverting the environment, and a baked
 // sphere's caustic and shadow on the ground. Volumes are built in memory with analytically smoothed
@@ -21,6 +21,7 @@
 #include "gl/shader_library.h"
 #include "lightsim/bake.h"
 #include "lightsim/cpu_simulator.h"
+#include "tests/reference/exact_optics.h"
 #include "viewer/environment.h"
 #include "viewer/loaded_scene.h"
 #include "viewer/scene_renderer.h"
@@ -86,16 +87,6 @@ Volume smoothedVolume(const SignedDistance& region, double n1, glm::dvec3 sigma_
           for (int c = 0; c < 3; ++c) absorption->voxel(index)[c] = static_cast<float>(sigma_a[c] * s);
       }
   return v;
-}
-
-// Exact unpolarised Fresnel reflectance (seeds/README.md).
-double fresnel(double n1, double n2, double cos_i) {
-  const double sin_t2 = (n1 / n2) * (n1 / n2) * (1 - cos_i * cos_i);
-  if (sin_t2 >= 1) return 1;
-  const double cos_t = std::sqrt(1 - sin_t2);
-  const double rs = (n1 * cos_i - n2 * cos_t) / (n1 * cos_i + n2 * cos_t);
-  const double rp = (n1 * cos_t - n2 * cos_i) / (n1 * cos_t + n2 * cos_i);
-  return 0.5 * (rs * rs + rp * rp);
 }
 
 class SceneRendererTest : public ::testing::Test {
@@ -170,7 +161,7 @@ TEST_F(SceneRendererTest, FresnelReflectanceOfAFlatBoundary) {
     const double theta = theta_deg * kPi / 180;
     const glm::dvec3 eye = 3.0 * glm::dvec3(0, std::cos(theta), std::sin(theta));
     const Image image = renderer.render(lookAt(eye, {0, 0, 0}, 4.0, {0, 0, -1}), {9, 9});
-    const double expected = fresnel(1.0, 1.5, std::cos(theta));
+    const double expected = reference::fresnelReflectance(1.0, 1.5, std::cos(theta));
     EXPECT_NEAR(image.at(4, 4)[1], expected, 0.02 * expected) << "at " << theta_deg << "°";
     RecordProperty("R_at_" + std::to_string(static_cast<int>(theta_deg)) + "deg",
                    std::to_string(image.at(4, 4)[1]) + " exact " + std::to_string(expected));
@@ -259,7 +250,7 @@ TEST_F(SceneRendererTest, TiltedSlabShiftsTheViewBySnellsLaw) {
   const double theta = 40.0 * kPi / 180, theta_t = std::asin(std::sin(theta) / 1.5);
   const double expected = 0.5 * std::sin(theta - theta_t) / std::cos(theta_t);
   EXPECT_NEAR(shift, expected, 0.5 * h);
-  // Most of what is left is the smoothing itself (DESIGN §5): the exact shift through the smoothed
+  // Most of what is left is the smoothing itself (docs/physics.md): the exact shift through the smoothed
   // profile n(z) is ∫ (tan θ₀ − tan θ(z)) dz · cos θ₀ with n(z)·sin θ(z) = sin θ₀. The renderer
   // matches it within a tenth of a voxel.
   const double sigma = kSmoothVoxels * h, dz = 1e-5;

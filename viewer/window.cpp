@@ -7,7 +7,6 @@
 #include <backends/imgui_impl_opengl3.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -15,6 +14,7 @@
 
 #include "core/error.h"
 #include "core/image_io.h"
+#include "core/stopwatch.h"
 #include "gl/context.h"
 #include "gl/framebuffer.h"
 #include "gl/shader_library.h"
@@ -177,7 +177,7 @@ int runViewerWindow(const LoadedScene& scene, const RenderSettings& initial_sett
   double frame_ms = 0.0;
   std::string status;
   int frame = 0;
-  auto last_frame = std::chrono::steady_clock::now();
+  Stopwatch frame_clock;  // since the last frame was shown
 
   // S: the current view at the window's full size (whatever the resolution slider says), rendered
   // as `--render` renders it; a failure to write is shown, not fatal.
@@ -294,11 +294,11 @@ int runViewerWindow(const LoadedScene& scene, const RenderSettings& initial_sett
       dirty = true;
     }
     if (dirty || scripted) {
-      const auto start = std::chrono::steady_clock::now();
+      const Stopwatch render_clock;
       hdr.bind();
       renderer.draw(orbit.camera(), render_size);
       glFinish();
-      render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      render_ms = render_clock.milliseconds();
       dirty = false;
     }
 
@@ -335,9 +335,7 @@ int runViewerWindow(const LoadedScene& scene, const RenderSettings& initial_sett
     imgui.render();
     if (last_scripted_frame && !options.save_ui.empty()) writeScreenPng(options.save_ui, fb);
     context.swapBuffers();
-    const auto now = std::chrono::steady_clock::now();
-    frame_ms = std::chrono::duration<double, std::milli>(now - last_frame).count();
-    last_frame = now;
+    frame_ms = frame_clock.restart() * 1e3;
   }
   return kExitOk;
 }

@@ -1,4 +1,4 @@
-// The interactive viewer (thesis §6.3; DESIGN §4.2 "viewer without --render opens a window"): a
+// The interactive viewer (thesis §6.3; docs/programs.md "viewer without --render opens a window"): a
 // GLFW window (gl::GlContext's window back end) showing SceneRenderer's HDR image through the
 // display pass (viewer/display_pass.h), with Dear ImGui controls on top.
 //

@@ -1,4 +1,4 @@
-// Compositing voxelised objects (Regions) into one material Volume (DESIGN §4.1, thesis §6.1).
+// Compositing voxelised objects (Regions) into one material Volume (docs/volume-format.md, thesis §6.1).
 //
 // Nested objects: the innermost wins. Regions are ordered by enclosed_volume, smallest first
 // (ties: the later input first); each voxel hands out its space greedily, f_i = min(cov_i,

@@ -2,13 +2,11 @@
 
 #include <tiny_gltf.h>
 
-#include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
-#include <fstream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -16,137 +14,17 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
-#include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/text.h"
+#include "voxelize/gltf_accessors.h"
+#include "voxelize/gltf_container.h"
+#include "voxelize/gltf_diagnostics.h"
+#include "voxelize/gltf_lights_cameras.h"
+#include "voxelize/gltf_materials.h"
 
 namespace eik {
 namespace {
-
-constexpr std::uint32_t kGlbMagic = 0x46546C67;      // "glTF"
-constexpr std::uint32_t kGlbChunkJson = 0x4E4F534A;  // "JSON"
-constexpr std::uint32_t kGlbChunkBin = 0x004E4942;   // "BIN\0"
-constexpr std::size_t kMaxElements = std::size_t(1) << 31;
-
-std::string str(std::size_t v) { return std::to_string(v); }
-std::string str(int v) { return std::to_string(v); }
-std::string indexed(const char* array, std::size_t i) { return std::string(array) + "[" + str(i) + "]"; }
-
-std::uint32_t readU32(const unsigned char* p) {
-  return std::uint32_t(p[0]) | (std::uint32_t(p[1]) << 8) | (std::uint32_t(p[2]) << 16) |
-         (std::uint32_t(p[3]) << 24);
-}
-
-std::vector<unsigned char> readBytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string(), "file", "cannot be opened");
-  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw InputError(path.string(), "file", "read error");
-  return bytes;
-}
-
-// Percent-decoding of a relative URI (tinygltf does the same when it opens the file).
-std::string decodeUri(const std::string& uri) {
-  std::string out;
-  for (std::size_t i = 0; i < uri.size(); ++i) {
-    if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(static_cast<unsigned char>(uri[i + 1])) &&
-        std::isxdigit(static_cast<unsigned char>(uri[i + 2]))) {
-      out.push_back(static_cast<char>(std::stoi(uri.substr(i + 1, 2), nullptr, 16)));
-      i += 2;
-    } else {
-      out.push_back(uri[i]);
-    }
-  }
-  return out;
-}
-
-// The GLB container: header and chunk table checked against the file size (tinygltf trusts them).
-struct GlbParts {
-  std::string json;
-  bool has_bin = false;
-  std::size_t bin_size = 0;
-};
-
-GlbParts splitGlb(const std::string& file, const std::vector<unsigned char>& bytes) {
-  const std::size_t size = bytes.size();
-  if (size < 12) throw InputError(file, "glb header", "truncated: " + str(size) + " bytes, a GLB header needs 12");
-  if (readU32(bytes.data()) != kGlbMagic) throw InputError(file, "glb header", "not a binary glTF (magic is not 'glTF')");
-  if (std::uint32_t version = readU32(bytes.data() + 4); version != 2)
-    throw InputError(file, "glb header", "version " + std::to_string(version) + " is not supported (expected 2)");
-  const std::size_t length = readU32(bytes.data() + 8);
-  if (length > size)
-    throw InputError(file, "glb header", "truncated: the header says " + str(length) + " bytes, the file has " + str(size));
-  if (length < 20) throw InputError(file, "glb chunk 0", "truncated: no JSON chunk");
-  const std::size_t json_length = readU32(bytes.data() + 12);
-  if (readU32(bytes.data() + 16) != kGlbChunkJson) throw InputError(file, "glb chunk 0", "the first chunk is not JSON");
-  if (json_length > length - 20)
-    throw InputError(file, "glb chunk 0",
-                     "truncated: the JSON chunk of " + str(json_length) + " bytes runs past the end of the file (" +
-                         str(length) + " bytes)");
-  GlbParts parts;
-  parts.json.assign(reinterpret_cast<const char*>(bytes.data()) + 20, json_length);
-  std::size_t offset = 20 + json_length;
-  if (offset < length) {
-    if (length - offset < 8) throw InputError(file, "glb chunk 1", "truncated chunk header");
-    const std::size_t chunk_length = readU32(bytes.data() + offset);
-    if (chunk_length > length - offset - 8)
-      throw InputError(file, "glb chunk 1",
-                       "truncated: the chunk of " + str(chunk_length) + " bytes runs past the end of the file");
-    if (readU32(bytes.data() + offset + 4) == kGlbChunkBin) {
-      parts.has_bin = true;
-      parts.bin_size = chunk_length;
-    }
-  }
-  return parts;
-}
-
-// JSON syntax and external buffer files, checked with messages that name the field.
-void precheckJson(const std::string& file, const std::string& text, const std::filesystem::path& base_dir,
-                  const GlbParts* glb) {
-  nlohmann::json root;
-  try {
-    root = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    std::string what = e.what();
-    if (auto pos = what.find("] "); what.rfind("[json.exception", 0) == 0 && pos != std::string::npos)
-      what = what.substr(pos + 2);
-    throw InputError(file, "json", what);
-  }
-  if (!root.is_object()) throw InputError(file, "json", "the top level is not an object");
-  auto buffers = root.find("buffers");
-  if (buffers == root.end() || !buffers->is_array()) return;
-  for (std::size_t i = 0; i < buffers->size(); ++i) {
-    const nlohmann::json& buffer = (*buffers)[i];
-    const std::string field = indexed("buffers", i);
-    if (!buffer.is_object()) throw InputError(file, field, "is not an object");
-    std::size_t byte_length = 0;
-    if (auto bl = buffer.find("byteLength"); bl != buffer.end()) {
-      if (!bl->is_number_unsigned()) throw InputError(file, field + ".byteLength", "is not a non-negative integer");
-      byte_length = bl->get<std::size_t>();
-    }
-    auto uri = buffer.find("uri");
-    if (uri == buffer.end()) {
-      if (glb && i == 0) {
-        if (!glb->has_bin) throw InputError(file, field, "refers to the GLB binary chunk, which the file lacks");
-        if (glb->bin_size < byte_length)
-          throw InputError(file, field, "byteLength " + str(byte_length) + " exceeds the GLB binary chunk (" +
-                                            str(glb->bin_size) + " bytes)");
-      }
-      continue;
-    }
-    if (!uri->is_string()) throw InputError(file, field + ".uri", "is not a string");
-    const std::string u = uri->get<std::string>();
-    if (u.rfind("data:", 0) == 0) continue;  // embedded; tinygltf decodes and checks it
-    const std::filesystem::path external = base_dir / decodeUri(u);
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(external, ec))
-      throw InputError(file, field + ".uri", "external buffer file '" + external.string() + "' not found");
-    const auto bytes = std::filesystem::file_size(external, ec);
-    if (!ec && bytes < byte_length)
-      throw InputError(file, field, "'" + external.string() + "' has " + str(static_cast<std::size_t>(bytes)) +
-                                        " bytes, byteLength says " + str(byte_length));
-  }
-}
 
 // Images are irrelevant to the voxeliser: skip decoding them.
 bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
@@ -162,59 +40,10 @@ std::vector<std::string> splitLines(const std::string& text) {
   return lines;
 }
 
-// --- accessors ------------------------------------------------------------------------------------
-
-double readComponent(const unsigned char* p, int component_type, bool normalized) {
-  switch (component_type) {
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: {
-      float f;
-      std::memcpy(&f, p, 4);
-      return f;
-    }
-    case TINYGLTF_COMPONENT_TYPE_BYTE: {
-      const auto v = static_cast<std::int8_t>(p[0]);
-      return normalized ? std::max(v / 127.0, -1.0) : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-      return normalized ? p[0] / 255.0 : p[0];
-    case TINYGLTF_COMPONENT_TYPE_SHORT: {
-      std::int16_t v;
-      std::memcpy(&v, p, 2);
-      return normalized ? std::max(v / 32767.0, -1.0) : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-      std::uint16_t v;
-      std::memcpy(&v, p, 2);
-      return normalized ? v / 65535.0 : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
-      std::uint32_t v;
-      std::memcpy(&v, p, 4);
-      return normalized ? v / 4294967295.0 : v;
-    }
-    default:
-      return 0.0;
-  }
-}
-
-std::string componentTypeName(int t) {
-  switch (t) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE: return "BYTE";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return "UNSIGNED_BYTE";
-    case TINYGLTF_COMPONENT_TYPE_SHORT: return "SHORT";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return "UNSIGNED_SHORT";
-    case TINYGLTF_COMPONENT_TYPE_INT: return "INT";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return "UNSIGNED_INT";
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: return "FLOAT";
-    case TINYGLTF_COMPONENT_TYPE_DOUBLE: return "DOUBLE";
-    default: return std::to_string(t);
-  }
-}
-
 class GltfReader {
  public:
   GltfReader(std::string file, const tinygltf::Model& model, MeshScene& scene)
-      : file_(std::move(file)), model_(model), scene_(scene) {}
+      : file_(std::move(file)), model_(model), scene_(scene), diag_{file_, &scene_.warnings}, accessors_(model_, diag_) {}
 
   void read() {
     checkRequiredExtensions();
@@ -247,10 +76,8 @@ class GltfReader {
   }
 
  private:
-  [[noreturn]] void fail(const std::string& field, const std::string& what) const {
-    throw InputError(file_, field, what);
-  }
-  void warn(const std::string& what) { scene_.warnings.push_back(file_ + ": " + what); }
+  [[noreturn]] void fail(const std::string& field, const std::string& what) const { diag_.fail(field, what); }
+  void warn(const std::string& what) { diag_.warn(what); }
 
   void checkRequiredExtensions() {
     static const std::set<std::string> unsupported = {"KHR_draco_mesh_compression", "EXT_meshopt_compression",
@@ -304,118 +131,16 @@ class GltfReader {
     const tinygltf::Node& node = model_.nodes[n];
     const glm::dmat4 world = parent * localMatrix(node, field);
     if (node.mesh >= 0) instanceMesh(node, field, world);
-    if (node.camera >= 0) placeCamera(node, field, world);
+    if (node.camera >= 0)
+      if (std::optional<SceneCamera> camera = gltfCamera(model_, node, field, world, diag_)) scene_.cameras.push_back(*camera);
     if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end())
-      placeLight(node, it->second, field, world);
+      if (std::optional<SceneLight> light = gltfLight(model_, node, it->second, field, world, diag_))
+        scene_.lights.push_back(*light);
     for (int c : node.children) {
       checkNodeIndex(c, field + ".children");
       visit(c, world);
     }
     on_path_[n] = false;
-  }
-
-  // Reads accessor `index` into `components` values per element, after checking everything the
-  // read relies on. `usage` says what it is for, in messages.
-  template <typename T>
-  std::vector<T> readAccessor(int index, std::initializer_list<int> types, std::initializer_list<int> component_types,
-                              const std::string& usage, int* components_out = nullptr) const {
-    if (index < 0 || static_cast<std::size_t>(index) >= model_.accessors.size())
-      fail(usage, "accessor " + str(index) + " out of range (the file has " + str(model_.accessors.size()) +
-                      " accessors)");
-    const tinygltf::Accessor& acc = model_.accessors[static_cast<std::size_t>(index)];
-    const std::string field = indexed("accessors", static_cast<std::size_t>(index));
-    const int components = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(acc.type));
-    if (components <= 0 || std::find(types.begin(), types.end(), acc.type) == types.end())
-      fail(field + ".type", "element type " + str(acc.type) + " cannot be used as " + usage);
-    const int csize = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(acc.componentType));
-    if (csize <= 0 ||
-        std::find(component_types.begin(), component_types.end(), acc.componentType) == component_types.end())
-      fail(field + ".componentType", componentTypeName(acc.componentType) + " cannot be used as " + usage);
-    const std::size_t element_size = static_cast<std::size_t>(components) * static_cast<std::size_t>(csize);
-    const std::size_t count = acc.count;
-    if (count > kMaxElements) fail(field + ".count", str(count) + " elements is more than this program reads");
-    if (components_out) *components_out = components;
-
-    std::vector<T> values(count * static_cast<std::size_t>(components), T(0));
-    auto read = [&](const unsigned char* element, std::size_t i) {
-      for (int c = 0; c < components; ++c)
-        values[i * static_cast<std::size_t>(components) + static_cast<std::size_t>(c)] =
-            static_cast<T>(readComponent(element + static_cast<std::size_t>(c * csize), acc.componentType, acc.normalized));
-    };
-
-    if (acc.bufferView >= 0) {
-      const std::size_t stride_default = element_size;
-      const auto [data, view_length, stride] = bufferView(acc.bufferView, field + ".bufferView", stride_default);
-      if (stride < element_size)
-        fail(indexed("bufferViews", static_cast<std::size_t>(acc.bufferView)) + ".byteStride",
-             str(stride) + " is smaller than the " + str(element_size) + "-byte elements of " + field);
-      if (count > 0) {
-        const unsigned __int128 need = static_cast<unsigned __int128>(acc.byteOffset) +
-                                       static_cast<unsigned __int128>(stride) * (count - 1) + element_size;
-        if (need > view_length)
-          fail(field, "reads past the end of bufferViews[" + str(acc.bufferView) + "]: " + str(count) +
-                          " elements from byteOffset " + str(acc.byteOffset) + " need " +
-                          str(static_cast<std::size_t>(need)) + " bytes, the view has " + str(view_length));
-        for (std::size_t i = 0; i < count; ++i) read(data + acc.byteOffset + i * stride, i);
-      }
-    } else if (!acc.sparse.isSparse && count > 0) {
-      fail(field + ".bufferView", "missing (and the accessor is not sparse)");
-    }
-
-    if (acc.sparse.isSparse) {
-      const std::string sfield = field + ".sparse";
-      const int scount = acc.sparse.count;
-      if (scount < 0 || static_cast<std::size_t>(scount) > count)
-        fail(sfield + ".count", str(scount) + " is not in [0, " + str(count) + "]");
-      const int itype = acc.sparse.indices.componentType;
-      const int isize = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(itype));
-      if (itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
-          itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
-        fail(sfield + ".indices.componentType", componentTypeName(itype) + " is not an unsigned integer type");
-      if (acc.sparse.indices.byteOffset < 0 || acc.sparse.values.byteOffset < 0)
-        fail(sfield, "negative byteOffset");
-      const auto [idata, ilength, istride] =
-          bufferView(acc.sparse.indices.bufferView, sfield + ".indices.bufferView", static_cast<std::size_t>(isize));
-      const auto [vdata, vlength, vstride] =
-          bufferView(acc.sparse.values.bufferView, sfield + ".values.bufferView", element_size);
-      (void)istride;
-      (void)vstride;
-      const auto ioff = static_cast<std::size_t>(acc.sparse.indices.byteOffset);
-      const auto voff = static_cast<std::size_t>(acc.sparse.values.byteOffset);
-      const auto n = static_cast<std::size_t>(scount);
-      if (ioff + n * static_cast<std::size_t>(isize) > ilength)
-        fail(sfield + ".indices", "reads past the end of its buffer view");
-      if (voff + n * element_size > vlength) fail(sfield + ".values", "reads past the end of its buffer view");
-      for (std::size_t s = 0; s < n; ++s) {
-        const auto target = static_cast<std::size_t>(readComponent(idata + ioff + s * static_cast<std::size_t>(isize), itype, false));
-        if (target >= count)
-          fail(sfield + ".indices", "index " + str(target) + " is out of range (count " + str(count) + ")");
-        read(vdata + voff + s * element_size, target);
-      }
-    }
-    return values;
-  }
-
-  struct ViewBytes {
-    const unsigned char* data;
-    std::size_t length;
-    std::size_t stride;
-  };
-
-  ViewBytes bufferView(int index, const std::string& usage, std::size_t default_stride) const {
-    if (index < 0 || static_cast<std::size_t>(index) >= model_.bufferViews.size())
-      fail(usage, "buffer view " + str(index) + " out of range (the file has " + str(model_.bufferViews.size()) +
-                      " buffer views)");
-    const tinygltf::BufferView& view = model_.bufferViews[static_cast<std::size_t>(index)];
-    const std::string field = indexed("bufferViews", static_cast<std::size_t>(index));
-    if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model_.buffers.size())
-      fail(field + ".buffer", "buffer " + str(view.buffer) + " out of range (the file has " +
-                                  str(model_.buffers.size()) + " buffers)");
-    const std::vector<unsigned char>& data = model_.buffers[static_cast<std::size_t>(view.buffer)].data;
-    if (view.byteOffset > data.size() || view.byteLength > data.size() - view.byteOffset)
-      fail(field, "byteOffset " + str(view.byteOffset) + " + byteLength " + str(view.byteLength) +
-                      " runs past the end of buffers[" + str(view.buffer) + "] (" + str(data.size()) + " bytes)");
-    return {data.data() + view.byteOffset, view.byteLength, view.byteStride ? view.byteStride : default_stride};
   }
 
   // --- meshes -------------------------------------------------------------------------------------
@@ -453,7 +178,7 @@ class GltfReader {
     if (pos == prim.attributes.end()) fail(field + ".attributes", "no POSITION attribute");
     if (!prim.targets.empty()) warnOnce("morph targets ignored: meshes are voxelised without morphing");
     const std::string pos_usage = field + ".attributes.POSITION";
-    const std::vector<double> xyz = readAccessor<double>(
+    const std::vector<double> xyz = accessors_.read<double>(
         pos->second, {TINYGLTF_TYPE_VEC3},
         {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
          TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
@@ -470,7 +195,7 @@ class GltfReader {
 
     std::vector<std::uint32_t> indices;
     if (prim.indices >= 0) {
-      indices = readAccessor<std::uint32_t>(prim.indices, {TINYGLTF_TYPE_SCALAR},
+      indices = accessors_.read<std::uint32_t>(prim.indices, {TINYGLTF_TYPE_SCALAR},
                                             {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
                                              TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
                                              TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT},
@@ -538,149 +263,13 @@ class GltfReader {
     if (warned_.insert(what).second) warn(what);
   }
 
-  // --- materials ----------------------------------------------------------------------------------
-
-  // A number in an extension object; `fallback` when the key is absent.
-  double extNumber(const tinygltf::Value* obj, const char* key, double fallback, const std::string& field) const {
-    if (!obj || !obj->IsObject() || !obj->Has(key)) return fallback;
-    const tinygltf::Value& v = obj->Get(key);
-    if (!v.IsNumber()) fail(field + "." + key, "is not a number");
-    const double d = v.GetNumberAsDouble();
-    if (!std::isfinite(d)) fail(field + "." + key, "is not finite");
-    return d;
-  }
-
-  glm::dvec3 extColor(const tinygltf::Value* obj, const char* key, glm::dvec3 fallback, const std::string& field) const {
-    if (!obj || !obj->IsObject() || !obj->Has(key)) return fallback;
-    const tinygltf::Value& v = obj->Get(key);
-    if (!v.IsArray() || v.ArrayLen() != 3) fail(field + "." + key, "is not an array of 3 numbers");
-    glm::dvec3 c;
-    for (int i = 0; i < 3; ++i) {
-      const tinygltf::Value& e = v.Get(i);
-      if (!e.IsNumber() || !std::isfinite(e.GetNumberAsDouble())) fail(field + "." + key, "is not an array of 3 numbers");
-      c[i] = e.GetNumberAsDouble();
-    }
-    return c;
-  }
-
-  static const tinygltf::Value* extension(const tinygltf::ExtensionMap& map, const char* name) {
-    auto it = map.find(name);
-    return it != map.end() && it->second.IsObject() ? &it->second : nullptr;
-  }
-
+  // The material of a primitive (cached: many primitives share one).
   Material material(int index) {
     auto cached = material_cache_.find(index);
     if (cached != material_cache_.end()) return cached->second;
-    const tinygltf::Material& m = model_.materials[static_cast<std::size_t>(index)];
-    const std::string field = indexed("materials", static_cast<std::size_t>(index));
-    const std::string ext_field = field + ".extensions.";
-    Material out;
-    out.name = m.name.empty() ? field : m.name;
-
-    const auto* transmission = extension(m.extensions, "KHR_materials_transmission");
-    const auto* ior_ext = extension(m.extensions, "KHR_materials_ior");
-    const auto* volume = extension(m.extensions, "KHR_materials_volume");
-    const auto* dispersion_ext = extension(m.extensions, "KHR_materials_dispersion");
-    const auto* strength_ext = extension(m.extensions, "KHR_materials_emissive_strength");
-
-    glm::dvec3 base(1.0);
-    if (m.pbrMetallicRoughness.baseColorFactor.size() >= 3)
-      base = {m.pbrMetallicRoughness.baseColorFactor[0], m.pbrMetallicRoughness.baseColorFactor[1],
-              m.pbrMetallicRoughness.baseColorFactor[2]};
-    out.albedo = glm::vec3(glm::clamp(base, 0.0, 1.0));
-
-    glm::dvec3 emissive(0.0);
-    if (m.emissiveFactor.size() == 3) emissive = {m.emissiveFactor[0], m.emissiveFactor[1], m.emissiveFactor[2]};
-    const double strength =
-        extNumber(strength_ext, "emissiveStrength", 1.0, ext_field + "KHR_materials_emissive_strength");
-    out.emission = glm::vec3(glm::max(emissive * strength, 0.0));
-
-    const double transmission_factor =
-        extNumber(transmission, "transmissionFactor", 0.0, ext_field + "KHR_materials_transmission");
-    if (transmission_factor > 0.0) {
-      double ior = extNumber(ior_ext, "ior", 1.5, ext_field + "KHR_materials_ior");
-      if (ior < 1.0) {
-        warn(ext_field + "KHR_materials_ior.ior: " + std::to_string(ior) + " < 1, using 1");
-        ior = 1.0;
-      }
-      out.ior = static_cast<float>(ior);
-      const std::string vfield = ext_field + "KHR_materials_volume";
-      const glm::dvec3 color = extColor(volume, "attenuationColor", glm::dvec3(1.0), vfield);
-      const double distance =
-          extNumber(volume, "attenuationDistance", std::numeric_limits<double>::infinity(), vfield);
-      if (distance > 0.0 && std::isfinite(distance)) {
-        const glm::dvec3 c = glm::clamp(color, 1e-6, 1.0);
-        out.sigma_a = glm::vec3(-glm::log(c) / distance);
-      } else if (distance <= 0.0) {
-        warn(vfield + ".attenuationDistance: " + std::to_string(distance) + " is not positive; no absorption");
-      }
-      const double dispersion = extNumber(dispersion_ext, "dispersion", 0.0, ext_field + "KHR_materials_dispersion");
-      out.dispersion_b = static_cast<float>(0.523655 * (ior - 1.0) * std::max(dispersion, 0.0) / 20.0);
-      out.opaque = false;
-    } else {
-      out.opaque = true;
-    }
+    const Material out = gltfMaterial(model_, index, diag_);
     material_cache_.emplace(index, out);
     return out;
-  }
-
-  // --- lights and cameras -------------------------------------------------------------------------
-
-  void placeLight(const tinygltf::Node& node, const tinygltf::Value& ext, const std::string& field,
-                  const glm::dmat4& world) {
-    const std::string lfield = field + ".extensions.KHR_lights_punctual.light";
-    if (!ext.IsObject() || !ext.Has("light") || !ext.Get("light").IsNumber())
-      fail(lfield, "missing or not a number");
-    const int index = ext.Get("light").GetNumberAsInt();
-    if (index < 0 || static_cast<std::size_t>(index) >= model_.lights.size())
-      fail(lfield, "light " + str(index) + " out of range (the file has " + str(model_.lights.size()) + " lights)");
-    const tinygltf::Light& l = model_.lights[static_cast<std::size_t>(index)];
-    SceneLight light;
-    if (l.type == "directional") light.type = SceneLight::Type::Directional;
-    else if (l.type == "point") light.type = SceneLight::Type::Point;
-    else if (l.type == "spot") light.type = SceneLight::Type::Spot;
-    else {
-      warn(indexed("KHR_lights_punctual.lights", static_cast<std::size_t>(index)) + ": type '" + l.type +
-           "' skipped");
-      return;
-    }
-    light.name = !l.name.empty() ? l.name : !node.name.empty() ? node.name : indexed("light", static_cast<std::size_t>(index));
-    light.position = glm::dvec3(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
-    glm::dvec3 dir = glm::dmat3(world) * glm::dvec3(0.0, 0.0, -1.0);
-    light.direction = glm::length(dir) > 0.0 ? glm::normalize(dir) : glm::dvec3(0.0, 0.0, -1.0);
-    if (l.color.size() == 3) light.color = {l.color[0], l.color[1], l.color[2]};
-    light.intensity = l.intensity;
-    light.range = l.range;
-    light.inner_cone_rad = l.spot.innerConeAngle;
-    light.outer_cone_rad = l.spot.outerConeAngle;
-    scene_.lights.push_back(light);
-  }
-
-  void placeCamera(const tinygltf::Node& node, const std::string& field, const glm::dmat4& world) {
-    if (static_cast<std::size_t>(node.camera) >= model_.cameras.size())
-      fail(field + ".camera", "camera " + str(node.camera) + " out of range (the file has " +
-                                  str(model_.cameras.size()) + " cameras)");
-    const tinygltf::Camera& c = model_.cameras[static_cast<std::size_t>(node.camera)];
-    if (c.type != "perspective") {
-      warn(indexed("cameras", static_cast<std::size_t>(node.camera)) + ": " + c.type + " camera skipped");
-      return;
-    }
-    SceneCamera cam;
-    cam.name = !c.name.empty() ? c.name : !node.name.empty() ? node.name : indexed("camera", static_cast<std::size_t>(node.camera));
-    cam.eye = glm::dvec3(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
-    glm::dvec3 forward = glm::dmat3(world) * glm::dvec3(0.0, 0.0, -1.0);
-    glm::dvec3 up = glm::dmat3(world) * glm::dvec3(0.0, 1.0, 0.0);
-    if (!(glm::length(forward) > 0.0)) fail(field, "camera transform is singular");
-    forward = glm::normalize(forward);
-    up -= glm::dot(up, forward) * forward;  // orthonormalise (non-uniform scale)
-    if (!(glm::length(up) > 0.0)) fail(field, "camera transform is singular");
-    cam.up = glm::normalize(up);
-    cam.target = cam.eye + forward;
-    cam.fov_y_deg = glm::degrees(c.perspective.yfov);
-    cam.aspect_ratio = c.perspective.aspectRatio;
-    cam.znear = c.perspective.znear;
-    cam.zfar = c.perspective.zfar;
-    scene_.cameras.push_back(cam);
   }
 
   std::string file_;
@@ -691,20 +280,21 @@ class GltfReader {
   std::map<int, Material> material_cache_;
   std::map<std::string, int> name_uses_;
   std::set<std::string> warned_;
+  GltfDiagnostics diag_;
+  GltfAccessors accessors_;
 };
 
 }  // namespace
 
 MeshScene loadGltf(const std::filesystem::path& path) {
   const std::string file = path.string();
-  const std::vector<unsigned char> bytes = readBytes(path);
+  const std::vector<unsigned char> bytes = readGltfBytes(path);
   if (bytes.size() > std::numeric_limits<unsigned int>::max())
     throw InputError(file, "file", "larger than 4 GiB; glTF loading is limited to 4 GiB");
   std::filesystem::path base_dir = path.parent_path();
   if (base_dir.empty()) base_dir = ".";
-  const bool glb = bytes.size() >= 4 && readU32(bytes.data()) == kGlbMagic;
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const bool glb = isGlb(bytes);
+  const std::string ext = lower(path.extension().string());
   if (ext == ".glb" && !glb) {
     if (bytes.size() < 4) throw InputError(file, "glb header", "truncated: " + str(bytes.size()) + " bytes");
     throw InputError(file, "glb header", "not a binary glTF (magic is not 'glTF')");
@@ -712,10 +302,10 @@ MeshScene loadGltf(const std::filesystem::path& path) {
 
   if (glb) {
     const GlbParts parts = splitGlb(file, bytes);
-    precheckJson(file, parts.json, base_dir, &parts);
+    precheckGltfJson(file, parts.json, base_dir, &parts);
   } else {
     if (bytes.empty()) throw InputError(file, "json", "the file is empty");
-    precheckJson(file, std::string(bytes.begin(), bytes.end()), base_dir, nullptr);
+    precheckGltfJson(file, std::string(bytes.begin(), bytes.end()), base_dir, nullptr);
   }
 
   tinygltf::TinyGLTF loader;

@@ -241,7 +241,7 @@ TEST_F(GltfLoader, MaterialExtensions) {
   EXPECT_FLOAT_EQ(clear.ior, 1.5f);
   EXPECT_EQ(clear.sigma_a, glm::vec3(0.0f));
 
-  const Material& none = scene.meshes[3].material;  // no material: glass n = 1.5 (DESIGN §4.2)
+  const Material& none = scene.meshes[3].material;  // no material: glass n = 1.5 (docs/programs.md)
   EXPECT_FALSE(none.opaque);
   EXPECT_FLOAT_EQ(none.ior, 1.5f);
   EXPECT_EQ(none.name, "glass");

@@ -1,5 +1,5 @@
 // Choosing the voxel grid for a set of objects: `--res`, `--pad` and `--bounds` of `voxelize`
-// (DESIGN §4.2).
+// (docs/programs.md).
 #pragma once
 
 #include <limits>

@@ -1,4 +1,4 @@
-// Optical material of one object (thesis §3.2, DESIGN §4.1): what a voxel fully inside it holds.
+// Optical material of one object (thesis §3.2, docs/volume-format.md): what a voxel fully inside it holds.
 #pragma once
 
 #include <string>
@@ -19,7 +19,7 @@ struct Material {
   glm::vec3 albedo{0.8f};              // diffuse albedo of an opaque material
 };
 
-// glTF KHR_materials_dispersion stores 20/V_d (V_d = Abbe number). DESIGN §4.1:
+// glTF KHR_materials_dispersion stores 20/V_d (V_d = Abbe number). docs/volume-format.md:
 // B = 0.523655·(n − 1)·dispersion/20, i.e. B = 0.523655·(n − 1)/V_d.
 inline float cauchyBFromAbbe(float ior, float abbe) {
   return abbe > 0.0f ? 0.523655f * (ior - 1.0f) / abbe : 0.0f;

@@ -8,30 +8,21 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/text.h"
 
 namespace eik {
-namespace {
 
-std::string trim(std::string_view text) {
-  const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; };
-  while (!text.empty() && space(text.front())) text.remove_prefix(1);
-  while (!text.empty() && space(text.back())) text.remove_suffix(1);
-  return std::string(text);
-}
-
-std::string formatNumber(double value) {
+std::string formatValue(double value) {
   std::ostringstream out;
   out << value;
   return out.str();
 }
 
-std::string joinKeys(const std::vector<std::string>& keys) {
+std::string joinedList(const std::vector<std::string>& items) {
   std::string out;
-  for (const auto& key : keys) out += (out.empty() ? "" : ", ") + key;
+  for (const auto& item : items) out += (out.empty() ? "" : ", ") + item;
   return out;
 }
-
-}  // namespace
 
 std::vector<KeyValue> splitKeyValues(const std::string& spec, const std::string& source) {
   std::vector<KeyValue> pairs;
@@ -40,14 +31,14 @@ std::vector<KeyValue> splitKeyValues(const std::string& spec, const std::string&
   std::size_t start = 0;
   for (;;) {
     const std::size_t comma = spec.find(',', start);
-    const std::string item = trim(std::string_view(spec).substr(start, comma == std::string::npos ? std::string::npos
-                                                                                                  : comma - start));
+    const std::string item(
+        trim(std::string_view(spec).substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
     const std::size_t eq = item.find('=');
     if (eq == std::string::npos)
       throw InputError(source, item.empty() ? "(empty item)" : item,
                        "expected KEY=VALUE (items are separated by commas)");
-    std::string key = trim(std::string_view(item).substr(0, eq));
-    std::string value = trim(std::string_view(item).substr(eq + 1));
+    std::string key(trim(std::string_view(item).substr(0, eq)));
+    std::string value(trim(std::string_view(item).substr(eq + 1)));
     if (key.empty()) throw InputError(source, item, "missing key before '='");
     if (!seen.insert(key).second) throw InputError(source, key, "given more than once");
     pairs.emplace_back(std::move(key), std::move(value));
@@ -58,7 +49,7 @@ std::vector<KeyValue> splitKeyValues(const std::string& spec, const std::string&
 }
 
 double parseNumber(const std::string& text, const std::string& source, const std::string& key) {
-  const std::string t = trim(text);
+  const std::string t(trim(text));
   double value = 0.0;
   const char* first = t.data();
   const char* last = t.data() + t.size();
@@ -109,7 +100,7 @@ Material applyMaterialOverrides(const std::vector<KeyValue>& pairs, Material bas
       if (have_ior) fail("ior and n are the same key; give one");
       have_ior = true;
       const double n = parseNumber(value, source, key);
-      if (n < 1.0) fail(formatNumber(n) + " is below 1 (a refractive index is at least 1, vacuum)");
+      if (n < 1.0) fail(formatValue(n) + " is below 1 (a refractive index is at least 1, vacuum)");
       base.ior = static_cast<float>(n);
     } else if (key == "sigma_a") {
       base.sigma_a = rgbAtLeastZero();
@@ -122,24 +113,24 @@ Material applyMaterialOverrides(const std::vector<KeyValue>& pairs, Material bas
       base.opaque = true;
     } else if (key == "scatter") {
       const double w = parseNumber(value, source, key);
-      if (w < 0.0 || w > 1.0) fail(formatNumber(w) + " is outside [0, 1]");
+      if (w < 0.0 || w > 1.0) fail(formatValue(w) + " is outside [0, 1]");
       base.scatter = static_cast<float>(w);
     } else if (key == "g") {
       const double g = parseNumber(value, source, key);
-      if (g <= -1.0 || g >= 1.0) fail(formatNumber(g) + " is outside (-1, 1)");
+      if (g <= -1.0 || g >= 1.0) fail(formatValue(g) + " is outside (-1, 1)");
       base.g = static_cast<float>(g);
     } else if (key == "abbe") {
       const double v = parseNumber(value, source, key);
-      if (v <= 0.0) fail(formatNumber(v) + " must be positive (glasses have Abbe numbers of about 20 to 90)");
+      if (v <= 0.0) fail(formatValue(v) + " must be positive (glasses have Abbe numbers of about 20 to 90)");
       abbe = v;
     } else if (key == "name") {
       if (value.empty()) fail("must not be empty");
       base.name = value;
     } else {
-      fail("unknown material key (valid keys: " + joinKeys(materialKeys()) + ")");
+      fail("unknown material key (valid keys: " + joinedList(materialKeys()) + ")");
     }
   }
-  // DESIGN §4.1: B = 0.523655·(n − 1)/V_d, with the final n.
+  // docs/volume-format.md: B = 0.523655·(n − 1)/V_d, with the final n.
   if (abbe) base.dispersion_b = cauchyBFromAbbe(base.ior, static_cast<float>(*abbe));
   return base;
 }

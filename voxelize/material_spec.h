@@ -1,4 +1,4 @@
-// Parsing of material overrides: `--material KEY=VALUE[,KEY=VALUE...]` (DESIGN §4.2), and the
+// Parsing of material overrides: `--material KEY=VALUE[,KEY=VALUE...]` (docs/programs.md), and the
 // small KEY=VALUE helpers that procedural shape specs (`procedural:NAME,key=value`) share with it.
 //
 // Keys (values are per world unit where they are coefficients):
@@ -8,7 +8,7 @@
 //   albedo=R:G:B   diffuse albedo in [0, 1]; makes the material an opaque embedding/receiver
 //   scatter=W      scatter strength (albedo) ω̂ in [0, 1] (thesis Eq. 3.5)
 //   g=G            Henyey–Greenstein anisotropy in (−1, 1)
-//   abbe=V         Abbe number V_d > 0; sets the Cauchy B = 0.523655·(n − 1)/V_d (DESIGN §4.1)
+//   abbe=V         Abbe number V_d > 0; sets the Cauchy B = 0.523655·(n − 1)/V_d (docs/volume-format.md)
 //   name=TEXT      name shown in messages and --stats
 #pragma once
 
@@ -34,6 +34,10 @@ std::vector<KeyValue> splitKeyValues(const std::string& spec, const std::string&
 double parseNumber(const std::string& text, const std::string& source, const std::string& key);
 // "R:G:B" or a single value for all three channels.
 glm::dvec3 parseTriple(const std::string& text, const std::string& source, const std::string& key);
+
+// How numbers and lists of keys appear in messages: "1.5" (ostream default format), "a, b, c".
+std::string formatValue(double value);
+std::string joinedList(const std::vector<std::string>& items);
 
 // The keys parseMaterialSpec accepts, in documentation order ("ior", "n", "sigma_a", ...).
 const std::vector<std::string>& materialKeys();

@@ -1,17 +1,14 @@
 #include "voxelize/mesh_scene.h"
 
-#include <algorithm>
-#include <cctype>
-
 #include "core/error.h"
+#include "core/text.h"
 #include "voxelize/gltf_loader.h"
 #include "voxelize/obj_loader.h"
 
 namespace eik {
 
 MeshScene loadMeshFile(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = lower(path.extension().string());
   if (ext == ".gltf" || ext == ".glb") return loadGltf(path);
   if (ext == ".obj") return loadObj(path);
   throw InputError(path.string(), "extension",

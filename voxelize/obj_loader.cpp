@@ -11,17 +11,13 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/text.h"
 
 namespace eik {
 namespace {
 
-bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
-
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && isSpace(s.front())) s.remove_prefix(1);
-  while (!s.empty() && isSpace(s.back())) s.remove_suffix(1);
-  return s;
-}
+// Lines never hold '\n' (the text is split at it), so eik::isSpace and eik::trim see exactly the
+// whitespace of an OBJ line: space, \t, \r, \f, \v.
 
 // Splits off the next whitespace-separated token of `rest`.
 std::string_view nextToken(std::string_view& rest) {

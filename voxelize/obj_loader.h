@@ -3,13 +3,13 @@
 // Reads `v` positions and `f` faces (v, v/vt, v//vn, v/vt/vn; negative = relative indices;
 // polygons fan-triangulated), splits meshes at `o`, `g` and `usemtl` (one TriangleMesh per
 // object/group + material, in order of first appearance). Materials are not read from .mtl
-// files: every mesh is the default glass (n = 1.5, DESIGN §4.2) named after its `usemtl`, and the
+// files: every mesh is the default glass (n = 1.5, docs/programs.md) named after its `usemtl`, and the
 // `--material` override is applied by the caller. Texture coordinates and normals are checked
 // but not kept.
 //
 // Why not tinyobjloader (Debian has libtinyobjloader-dev 2.0.0~rc10): it turns a non-numeric value
 // into 0 without a word, and we must name the file, line and field of every malformed value
-// (DESIGN §4.2); the few things we need fit in a page, and a 16 MB, 280k-triangle file loads in
+// (docs/programs.md); the few things we need fit in a page, and a 16 MB, 280k-triangle file loads in
 // under 0.1 s.
 #pragma once
 

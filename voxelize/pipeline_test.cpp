@@ -1,6 +1,6 @@
 // The voxelize pipeline end to end (procedural shape → composite → smoothed n → ∇n) against
 // analytic answers. All tests assume the default pre-smoothing σ = 0.75 voxel unless they say
-// otherwise (DESIGN §5: tests state the σ they assume).
+// otherwise (docs/physics.md: tests state the σ they assume).
 #include "voxelize/pipeline.h"
 
 #include <gtest/gtest.h>
@@ -10,6 +10,9 @@
 #include <numbers>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "core/testing.h"
 #include "voxelize/grid_builder.h"
 #include "voxelize/procedural.h"
 
@@ -312,6 +315,59 @@ TEST(Pipeline, ReportsProgressUpToOne) {
     EXPECT_GE(f, 0.0);
     EXPECT_LE(f, 1.0);
   }
+}
+
+// The whole run as `voxelize` makes it: the same volume as the library steps, stats, and the
+// option checks that come before any work (tests/voxelize_cli_test.cpp checks the program itself).
+TEST(VoxelizeFiles, WritesTheVolumeTheStepsBuild) {
+  test_support::TempDir dir;
+  VoxelizeOptions options;
+  options.inputs = {"procedural:sphere,r=0.5,ior=1.5"};
+  options.output = (dir / "sphere.vol.json").string();
+  options.stats = (dir / "stats.json").string();
+  options.res = 12;
+  options.quiet = true;
+  voxelizeFiles(options);
+
+  const ProceduralSpec spec = parseProceduralSpec(options.inputs[0]);
+  const GridSpec grid = makeGrid(proceduralBounds(spec), 12);
+  const Volume expected = buildVolume(voxelizeProcedural(spec, grid), grid);
+  const Volume written = readVolume(dir / "sphere.vol.json");
+  EXPECT_EQ(written.grid.dims, grid.dims);
+  ASSERT_EQ(written.fields.size(), expected.fields.size());
+  for (const auto& [name, field] : expected.fields) EXPECT_EQ(written.fields.at(name).data, field.data) << name;
+  EXPECT_EQ(written.metadata.at("source").at("program"), "voxelize");
+
+  const nlohmann::json stats = nlohmann::json::parse(test_support::readFile(dir / "stats.json"));
+  EXPECT_EQ(stats.at("voxels").get<std::size_t>(), grid.count());
+  EXPECT_EQ(stats.at("objects").size(), 1u);
+  EXPECT_EQ(stats.at("objects")[0].at("region"), "sphere");
+  for (const char* key : {"time_occupancy_s", "time_fields_s", "time_write_s", "time_total_s", "peak_memory_mib"})
+    EXPECT_TRUE(stats.contains(key)) << key;
+}
+
+TEST(VoxelizeFiles, ChecksTheOptionsBeforeAnyWork) {
+  test_support::TempDir dir;
+  auto errorOf = [](VoxelizeOptions options) {
+    options.quiet = true;
+    return test_support::inputErrorOf([&] { voxelizeFiles(options); });
+  };
+  VoxelizeOptions o;
+  EXPECT_EQ(errorOf(o), "command line: INPUT: no input given (see voxelize --help)");
+  o.inputs = {"procedural:sphere"};
+  EXPECT_EQ(errorOf(o), "command line: -o: no output given (-o OUT.vol.json)");
+  o.output = (dir / "sphere.nrrd").string();
+  EXPECT_CONTAINS(errorOf(o), "the output manifest must end in .vol.json");
+  o.output = (dir / "sphere.vol.json").string();
+  o.smooth = 9;
+  EXPECT_EQ(errorOf(o), "--smooth: must be in [0, 8] voxels");
+  o.smooth = 0.75;
+  o.stats = (dir / "missing" / "stats.json").string();
+  EXPECT_CONTAINS(errorOf(o), "does not exist");
+  o.stats.clear();
+  o.materials = {"ior=1.5", "ior=1.6"};
+  EXPECT_EQ(errorOf(o), "--material: given 2 times for 1 OBJ/procedural inputs (give it once, or once per such input)");
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{}) << "nothing written";
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// The SCENE.json that `voxelize` writes beside a volume (DESIGN §4.3): glTF lights
+// The SCENE.json that `voxelize` writes beside a volume (docs/scene-format.md): glTF lights
 // (KHR_lights_punctual) and cameras converted to the programs' radiometric units, or a default
 // camera and light that frame the volume.
 #pragma once
@@ -19,7 +19,7 @@ struct SceneExport {
   std::vector<std::string> warnings;   // e.g. a spot light exported as a point light
 };
 
-// Photometric → radiometric (DESIGN §4.3 is linear radiometry): glTF gives a directional light's
+// Photometric → radiometric (docs/scene-format.md is linear radiometry): glTF gives a directional light's
 // illuminance in lux and a point light's luminous intensity in candela. With 683 lm/W (the
 // luminous efficacy at 555 nm, which Blender's exporter also uses: 1 W/m² ↦ 683 lux) the
 // irradiance is E = color·lux/683 W/m² and the radiant intensity I = color·cd/683 W/sr.

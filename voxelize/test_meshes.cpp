@@ -77,4 +77,34 @@ TriangleMesh makeRectangle(const glm::dvec3& corner, const glm::dvec3& u, const 
   return mesh;
 }
 
+TriangleMesh punchHoles(const TriangleMesh& mesh, const glm::dvec3& center, const std::vector<glm::dvec3>& directions) {
+  std::vector<bool> removed(mesh.triangles.size(), false);
+  for (const glm::dvec3& d : directions) {
+    std::size_t best = 0;
+    double best_dot = -2.0;
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const glm::dvec3 c = (mesh.corner(t, 0) + mesh.corner(t, 1) + mesh.corner(t, 2)) / 3.0 - center;
+      const double dot = glm::dot(glm::normalize(c), glm::normalize(d));
+      if (dot > best_dot && !removed[t]) {
+        best_dot = dot;
+        best = t;
+      }
+    }
+    removed[best] = true;
+  }
+  TriangleMesh out = mesh;
+  out.triangles.clear();
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    if (!removed[t]) out.triangles.push_back(mesh.triangles[t]);
+  return out;
+}
+
+GridSpec cubeGrid(const glm::dvec3& center, double side, int res) {
+  GridSpec g;
+  g.dims = glm::ivec3(res);
+  g.bounds_min = center - glm::dvec3(side / 2);
+  g.bounds_max = center + glm::dvec3(side / 2);
+  return g;
+}
+
 }  // namespace eik

@@ -3,6 +3,8 @@
 // declares the samplers uVolumeTex0..N-1 that VolumeTextures::bind() sets.
 // `uvw` is the texture coordinate: voxel (i,j,k) sits at ((i,j,k) + 0.5) / dims.
 // A field the volume lacks returns its neutral value (n = 1, zero elsewhere) at no cost.
+// The viewer, which samples several volumes in one shader, puts a copy of this file in each
+// object's scope with the samplers and functions renamed by #defines (viewer/raymarch_shader.h).
 #ifndef VOLUME_TEXTURE_COUNT
 #error "common/volume.glsl needs the defines of gl::VolumeTextureLayout::glslDefines()"
 #endif

@@ -1,17 +1,16 @@
-// Unpolarised Fresnel reflectance (seeds/README.md, the corrected Eq. 3.6):
-// R = (Rs + Rp)/2, Rs = ((ni cos θi − nt cos θt)/(ni cos θi + nt cos θt))²,
-// Rp = ((ni cos θt − nt cos θi)/(ni cos θt + nt cos θi))², R = 1 beyond the critical angle.
+// The light simulator's Fresnel reflectance: the shared unpolarised formula (common/fresnel.glsl,
+// the corrected Eq. 3.6) with this program's guards, and its rule for a boundary layer.
+#include "common/fresnel.glsl"
+
+// R going from index ni into nt at an angle of incidence with cosine |cosI|; 1 beyond the critical
+// angle, and where the indices make a denominator vanish.
 float fresnelReflectance(float ni, float nt, float cosI) {
   cosI = min(abs(cosI), 1.0);
-  float eta = ni / nt;
-  float sinT2 = eta * eta * (1.0 - cosI * cosI);
+  float sinT2 = snellSinT2(ni, nt, cosI);
   if (sinT2 >= 1.0) return 1.0;
   float cosT = sqrt(1.0 - sinT2);
-  float rsDen = ni * cosI + nt * cosT, rpDen = ni * cosT + nt * cosI;
-  if (rsDen <= 0.0 || rpDen <= 0.0) return 1.0;
-  float rs = (ni * cosI - nt * cosT) / rsDen;
-  float rp = (ni * cosT - nt * cosI) / rpDen;
-  return 0.5 * (rs * rs + rp * rp);
+  if (ni * cosI + nt * cosT <= 0.0 || ni * cosT + nt * cosI <= 0.0) return 1.0;
+  return fresnelUnpolarised(ni, nt, cosI, cosT);
 }
 
 // The reflectance a patch gets on leaving a boundary layer (ALGORITHM.md step 3 as the CPU twin

@@ -1,4 +1,4 @@
-// The volume grid as the light simulator's shaders see it (lightsim/atlas.h GridUniforms), and the
+// The volume grid as the light simulator's shaders see it (lightsim/grid_uniforms.h GridUniforms), and the
 // field sampling of ALGORITHM.md "Units and inputs": trilinear at voxel centres, clamp to edge,
 // uvw = (x − bounds_min) / extent. Needs common/volume.glsl (the volume's layout defines).
 uniform vec3 uBoundsMin;

@@ -1,7 +1,7 @@
 #version 330 core
 // The energy ledger (ALGORITHM.md "Bake output", energy check), accumulated on the GPU: one
 // GL_POINTS primitive per patch (gl_VertexID = patch index) with additive blending into eight
-// small RGBA32F targets, one per entry (lightsim/gpu_simulator.cpp, Ledger):
+// small RGBA32F targets, one per entry (lightsim/ledger_pass.h, LedgerPass):
 //   0 absorbed (Φ, 0)       (step 2)      4 folded kills (Φ, count)
 //   1 reflected (Φ, count)  (step 3)      5 depth kills (Φ, count)
 //   2 exited (Φ, count)     (step 5)      6 splits (0, count)

@@ -3,7 +3,7 @@
 //   [0..3] P0..P3 = (x_c, w_c.x)   [4] W01 = (w0.yz, w1.yz)   [5] W23 = (w2.yz, w3.yz)
 //   [6] FLUX = (Φ.rgb, A0)         [7] META = (depth, n_in, cos_in, T_fresnel)
 // A list is read through a sampler array `uniform sampler2D NAME[8];` indexed with constants only
-// (GLSL 3.30 cannot index sampler arrays with a variable, DESIGN §3): FETCH_PATCH(NAME, texel, p).
+// (GLSL 3.30 cannot index sampler arrays with a variable, docs/architecture.md): FETCH_PATCH(NAME, texel, p).
 
 struct Patch {
   vec3 x[4];     // corner positions (world)

@@ -6,7 +6,7 @@
 //      x' = w/n², w' = ∇n/n, stepped with Euler (Eq. 6.1/6.2), RK2 (midpoint) or RK4
 //      (INTEGRATOR_EULER / _RK2 / _RK4), then w renormalised to n at the new position.
 //   2. Absorption: Φ ← Φ·exp(−σa(m_old)·Δs_m), Δs_m = Δt / n(m_old) (Eq. 4.11).
-//   3. Fresnel boundary tracking (DESIGN §5): enter a layer when |∇n(m_new)|·h > g_on, leave it
+//   3. Fresnel boundary tracking (docs/physics.md): enter a layer when |∇n(m_new)|·h > g_on, leave it
 //      when < g_off and keep the transmitted fraction 1 − R (boundaryReflectance, fresnel.glsl).
 #include "common/volume.glsl"
 #include "lightsim/grid.glsl"

@@ -4,6 +4,8 @@
 // packed RGBA texture (∇n in RGB, n in A), no shading, no early termination, no empty-space
 // skipping. Out: RGB the exit direction (world, as 0.5 + 0.5·d), A the number of steps taken, so
 // the caller can count the samples exactly.
+#include "common/box.glsl"
+
 uniform sampler3D uPacked;      // (∂n/∂x, ∂n/∂y, ∂n/∂z, n) in the volume's own units
 uniform mat4 uInvViewProj;      // clip → world
 uniform vec3 uEye;              // world
@@ -23,13 +25,9 @@ void main() {
   vec3 o = (uWorldToVolume * vec4(uEye, 1.0)).xyz;
   vec3 d = normalize(mat3(uWorldToVolume) * dirWorld);
 
-  vec3 inv = 1.0 / d;
-  vec3 t0 = (uBoundsMin - o) * inv;
-  vec3 t1 = (uBoundsMax - o) * inv;
-  float tNear = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z));
-  float tFar = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
+  float tNear, tFar;
   int steps = 0;
-  if (tFar > max(tNear, 0.0)) {
+  if (intersectBox(o, d, uBoundsMin, uBoundsMax, tNear, tFar)) {
     vec3 extent = uBoundsMax - uBoundsMin;
     vec3 x = o + d * (max(tNear, 0.0) + 1e-4 * length(extent));
     vec3 w = d;  // |w| = n after the first step

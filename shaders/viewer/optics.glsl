@@ -1,18 +1,15 @@
-// Optics shared by the viewer's ray caster: Fresnel (seeds/README.md, the exact unpolarised
-// equations, not the thesis' Eq. 3.6), Henyey–Greenstein (the 3D-normalised form, not Eq. 3.5),
-// box intersection. Needs common/constants.glsl.
+// Optics shared by the viewer's ray caster: Fresnel (the shared formula of common/fresnel.glsl with
+// the viewer's guard), Henyey–Greenstein (the 3D-normalised form, not Eq. 3.5), the renormalisation
+// of w across a boundary layer. Needs common/constants.glsl.
+#include "common/fresnel.glsl"
 
-// Unpolarised Fresnel reflectance R = (Rs + Rp) / 2 going from index n1 into n2 at an angle of
-// incidence with cosine cosI; 1 beyond the critical angle.
+// Unpolarised Fresnel reflectance R = (Rs + Rp) / 2 (corrected Eq. 3.6) going from index n1 into
+// n2 at an angle of incidence with cosine cosI (clamped to [0, 1]); 1 beyond the critical angle.
 float fresnelReflectance(float n1, float n2, float cosI) {
   cosI = clamp(cosI, 0.0, 1.0);
-  float eta = n1 / n2;
-  float sinT2 = eta * eta * (1.0 - cosI * cosI);
+  float sinT2 = snellSinT2(n1, n2, cosI);
   if (sinT2 >= 1.0) return 1.0;
-  float cosT = sqrt(1.0 - sinT2);
-  float rs = (n1 * cosI - n2 * cosT) / (n1 * cosI + n2 * cosT);
-  float rp = (n1 * cosT - n2 * cosI) / (n1 * cosT + n2 * cosI);
-  return 0.5 * (rs * rs + rp * rp);
+  return fresnelUnpolarised(n1, n2, cosI, sqrt(1.0 - sinT2));
 }
 
 // Henyey–Greenstein phase function, normalised over the sphere: (1 − g²) / (4π (1 + g² − 2g cosθ)^1.5),
@@ -22,22 +19,9 @@ float henyeyGreenstein(float g, float cosTheta) {
   return (1.0 - g * g) * INV_FOUR_PI / (denom * sqrt(max(denom, 1e-12)));
 }
 
-// Slab test against [bmin, bmax] for the ray o + t·d (d need not be unit: t is in units of |d|).
-// False when the ray misses the box or the box lies behind the origin.
-bool intersectBox(vec3 o, vec3 d, vec3 bmin, vec3 bmax, out float tNear, out float tFar) {
-  vec3 inv = 1.0 / d;
-  vec3 t0 = (bmin - o) * inv;
-  vec3 t1 = (bmax - o) * inv;
-  vec3 lo = min(t0, t1);
-  vec3 hi = max(t0, t1);
-  tNear = max(max(lo.x, lo.y), lo.z);
-  tFar = min(min(hi.x, hi.y), hi.z);
-  return tFar > max(tNear, 0.0);
-}
-
 float maxComponent(vec3 v) { return max(max(v.x, v.y), v.z); }
 
-// w rescaled to |w| = n (DESIGN §5: an exact ray keeps |w| = n). The correction goes along ∇n, the
+// w rescaled to |w| = n (docs/physics.md: an exact ray keeps |w| = n). The correction goes along ∇n, the
 // direction in which the ray equation changes w (Eq. 5.12), so the component of w across ∇n is
 // kept: in a layered medium that component is n·sin θ, and keeping it is Snell's law exactly.
 // Where it cannot (at the turning point of a total internal reflection, where the step overshot

@@ -8,10 +8,11 @@
 // ray leaving one object continues into the next one it meets (so one is seen through another).
 // With DISPERSION, R, G and B follow their own rays at λ = 0.61, 0.55, 0.465 µm (thesis §3.2.7).
 //
-// Defines (SceneRenderer): OBJECT_COUNT, MAX_SEGMENTS, LIGHT_COUNT; GROUND, FRESNEL, ATTENUATION,
+// Defines (viewer/raymarch_shader.h): OBJECT_COUNT, MAX_SEGMENTS, LIGHT_COUNT; GROUND, FRESNEL, ATTENUATION,
 // EMISSION, SCATTERING, DISPERSION, NO_REFRACTION, RK4; OUTPUT_EXIT_POSITION, OUTPUT_EXIT_DIRECTION;
 // the environment's ENV_*.
 #include "common/constants.glsl"
+#include "common/box.glsl"
 #include "viewer/optics.glsl"
 #include "viewer/environment.glsl"
 
@@ -104,11 +105,27 @@ vec3 groundRadiance(vec3 xw);  // after the objects: it asks each one for its ba
 const float kGroundBlendVoxels = 3.0;  // the bake fades into the unoccluded light over this margin
 #endif
 
+// Every object's march (march0, march1, ...): viewer/raymarch_shader.cpp puts one instance of
+// viewer/object.glsl per object in place of the next line.
 // @OBJECTS@
 
+// Object k's march. A line marked EACH_OBJECT is repeated once per object (its index in place of
+// each at-sign): GLSL 3.30 cannot pick an object's samplers by a variable index.
+void marchObject(int k, inout Ray r, float cauchy) {
+  if (k == @) march@(r, cauchy);  // @EACH_OBJECT@
+}
+
 #ifdef GROUND
+// The baked irradiance of the first object whose volume holds the ground point xw, and its weight.
+float bakedGroundIrradiance(vec3 xw, out vec3 E) {
+  float weight;
+  weight = bakedGroundIrradiance@(xw, E); if (weight > 0.0) return weight;  // @EACH_OBJECT@
+  E = vec3(0.0);
+  return 0.0;
+}
+
 // Lambertian ground: ρE/π with the baked irradiance where it lies inside a baked volume (caustics,
-// shadows), the scene's lights unoccluded elsewhere (DESIGN §5 "Receivers"), plus the environment.
+// shadows), the scene's lights unoccluded elsewhere (docs/physics.md "Receivers"), plus the environment.
 vec3 groundRadiance(vec3 xw) {
   vec3 baked;
   float weight = bakedGroundIrradiance(xw, baked);
@@ -184,7 +201,7 @@ void main() {
   outColor = vec4(r.d, r.entered ? 1.0 : 0.0);
 #endif
 #elif defined(DISPERSION)
-  // Cauchy terms 1/λ² − 1/λ_d² (µm⁻²) of the three channels, λ_d = 0.5876 µm (DESIGN §4.1).
+  // Cauchy terms 1/λ² − 1/λ_d² (µm⁻²) of the three channels, λ_d = 0.5876 µm (docs/volume-format.md).
   const vec3 lambda = vec3(0.61, 0.55, 0.465);
   vec3 cauchy = 1.0 / (lambda * lambda) - vec3(1.0 / (0.5876 * 0.5876));
   vec3 colour;

@@ -1,0 +1,172 @@
+#include "core/gzip_stream.h"
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <vector>
+
+#include "core/error.h"
+#include "core/parallel.h"
+
+namespace eik {
+namespace {
+
+struct InflateStream {
+  z_stream z{};
+  bool ready = false;
+  ~InflateStream() {
+    if (ready) inflateEnd(&z);
+  }
+};
+
+struct DeflateStream {
+  z_stream z{};
+  bool ready = false;
+  ~DeflateStream() {
+    if (ready) deflateEnd(&z);
+  }
+};
+
+}  // namespace
+
+GzipReadResult readGzipStream(std::FILE* file, std::span<std::byte> out, std::uint64_t skip) {
+  GzipReadResult result;
+  InflateStream stream;
+  if (inflateInit2(&stream.z, 15 + 32) != Z_OK) {
+    result.status = GzipReadStatus::InitFailed;
+    return result;
+  }
+  stream.ready = true;
+  z_stream& z = stream.z;
+  auto end = [&](GzipReadStatus status, std::string detail = {}) {
+    result.status = status;
+    result.detail = std::move(detail);
+    return result;
+  };
+
+  std::vector<unsigned char> input(std::size_t{1} << 20);
+  std::vector<unsigned char> scratch(std::size_t{1} << 16);
+  std::uint64_t skip_left = skip;
+  std::size_t& filled = result.filled;
+  std::uint64_t& extra = result.surplus;
+  bool end_of_file = false;
+  bool stream_ended = false;
+
+  while (true) {
+    if (z.avail_in == 0 && !end_of_file) {
+      std::size_t n = std::fread(input.data(), 1, input.size(), file);
+      if (n == 0) {
+        if (std::ferror(file)) return end(GzipReadStatus::ReadError, std::strerror(errno));
+        end_of_file = true;
+      }
+      z.next_in = input.data();
+      z.avail_in = static_cast<uInt>(n);
+    }
+    if (stream_ended) {
+      if (z.avail_in == 0 && end_of_file) break;
+      if (z.avail_in == 0) continue;
+      inflateReset(&z);  // another gzip member follows
+      stream_ended = false;
+    }
+
+    enum { Skip, Fill, Surplus } phase = skip_left > 0 ? Skip : (filled < out.size() ? Fill : Surplus);
+    uInt capacity;
+    if (phase == Skip) {
+      z.next_out = scratch.data();
+      capacity = static_cast<uInt>(std::min<std::uint64_t>(scratch.size(), skip_left));
+    } else if (phase == Fill) {
+      z.next_out = reinterpret_cast<unsigned char*>(out.data() + filled);
+      capacity = static_cast<uInt>(std::min<std::size_t>(out.size() - filled, std::size_t{1} << 30));
+    } else {
+      z.next_out = scratch.data();
+      capacity = static_cast<uInt>(scratch.size());
+    }
+    z.avail_out = capacity;
+    int status = inflate(&z, Z_NO_FLUSH);
+    std::size_t produced = capacity - z.avail_out;
+    if (phase == Skip) {
+      skip_left -= produced;
+    } else if (phase == Fill) {
+      filled += produced;
+    } else {
+      extra += produced;
+      if (extra > 0) return end(GzipReadStatus::Surplus);
+    }
+    if (status == Z_STREAM_END) {
+      stream_ended = true;
+    } else if (status == Z_BUF_ERROR) {
+      // No progress is possible: more input is needed, and there is none.
+      if (z.avail_in == 0 && end_of_file) {
+        return end(filled < out.size() ? GzipReadStatus::EndsEarly : GzipReadStatus::MissingTrailer);
+      }
+    } else if (status != Z_OK) {
+      return end(GzipReadStatus::Corrupt, z.msg ? z.msg : "zlib error");
+    }
+  }
+  if (skip_left > 0) return end(GzipReadStatus::SkipNotReached);
+  if (filled < out.size()) return end(GzipReadStatus::Truncated);
+  return result;
+}
+
+void writeGzipStream(std::span<const unsigned char> bytes, const GzipSink& write, const std::string& name) {
+  constexpr std::size_t kBlock = std::size_t{4} << 20;
+  constexpr std::size_t kWindow = 32768;
+  const std::size_t blocks = std::max<std::size_t>(1, (bytes.size() + kBlock - 1) / kBlock);
+  // ID1 ID2 CM=deflate FLG=0 MTIME=0 (reproducible output) XFL=4 (fastest) OS=3 (Unix)
+  const unsigned char header[10] = {0x1f, 0x8b, 8, 0, 0, 0, 0, 0, 4, 3};
+  write(header, sizeof header);
+
+  uLong crc = crc32(0, Z_NULL, 0);
+  const std::size_t batch = 2 * static_cast<std::size_t>(workerThreads());
+  std::vector<std::string> compressed(batch);
+  std::vector<uLong> crcs(batch);
+  for (std::size_t first = 0; first < blocks; first += batch) {
+    const std::size_t count = std::min(batch, blocks - first);
+    parallelFor(0, static_cast<std::int64_t>(count), [&](std::int64_t k) {
+      const std::size_t block = first + static_cast<std::size_t>(k);
+      const std::size_t begin = block * kBlock;
+      const std::size_t length = std::min(kBlock, bytes.size() - begin);
+      const bool last = block + 1 == blocks;
+      DeflateStream stream;
+      // Level 1: float fields compress little better at higher levels, and 200 MB must write in seconds.
+      if (deflateInit2(&stream.z, Z_BEST_SPEED, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY) != Z_OK) {
+        throw RuntimeError(name + ": zlib init failed");
+      }
+      stream.ready = true;
+      z_stream& z = stream.z;
+      if (block > 0) deflateSetDictionary(&z, bytes.data() + begin - kWindow, static_cast<uInt>(kWindow));
+      std::string& output = compressed[static_cast<std::size_t>(k)];
+      output.resize(deflateBound(&z, static_cast<uLong>(length)) + 64);
+      z.next_in = const_cast<unsigned char*>(bytes.data() + begin);
+      z.avail_in = static_cast<uInt>(length);
+      std::size_t produced = 0;
+      while (true) {
+        z.next_out = reinterpret_cast<unsigned char*>(output.data() + produced);
+        z.avail_out = static_cast<uInt>(output.size() - produced);
+        int status = deflate(&z, last ? Z_FINISH : Z_SYNC_FLUSH);
+        produced = output.size() - z.avail_out;
+        if (status == Z_STREAM_ERROR) throw RuntimeError(name + ": gzip compression failed");
+        if (last ? status == Z_STREAM_END : (z.avail_in == 0 && z.avail_out != 0)) break;
+        output.resize(output.size() * 2);  // not reached with deflateBound's size; kept for safety
+      }
+      output.resize(produced);
+      crcs[static_cast<std::size_t>(k)] = crc32(0, bytes.data() + begin, static_cast<uInt>(length));
+    });
+    for (std::size_t k = 0; k < count; ++k) {
+      const std::size_t length = std::min(kBlock, bytes.size() - (first + k) * kBlock);
+      write(compressed[k].data(), compressed[k].size());
+      crc = crc32_combine(crc, crcs[k], static_cast<z_off_t>(length));
+    }
+  }
+  const std::uint64_t size = bytes.size();
+  unsigned char trailer[8];
+  for (int i = 0; i < 4; ++i) {
+    trailer[i] = static_cast<unsigned char>(crc >> (8 * i));
+    trailer[4 + i] = static_cast<unsigned char>(size >> (8 * i));  // ISIZE: the size modulo 2^32
+  }
+  write(trailer, sizeof trailer);
+}
+
+}  // namespace eik

@@ -1,0 +1,26 @@
+// GridUniforms: the volume grid as the light simulator's shaders see it (shaders/lightsim/grid.glsl:
+// uBoundsMin, uBoundsMax, uInvExtent, uVoxelEdge, uVoxelVolume, uDims), in float. Every full-screen
+// pass that samples the volume (update, analysis, compaction) sets them. GpuSimulator builds them
+// from the grid in grid-local coordinates (x − the grid's centre), so that float positions keep their
+// precision however far the volume sits from the world origin.
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include "core/grid.h"
+#include "gl/program.h"
+
+namespace eik::gpu {
+
+struct GridUniforms {
+  glm::vec3 boundsMin{0.0f};
+  glm::vec3 boundsMax{0.0f};
+  glm::vec3 invExtent{1.0f};  // uvw = (x − boundsMin) · invExtent
+  float voxelEdge = 1.0f;     // h, the smallest voxel edge
+  float voxelVolume = 1.0f;   // V_voxel
+  glm::ivec3 dims{1};         // for EXACT_TRILINEAR sampling
+  static GridUniforms from(const GridSpec& grid);
+  void set(const gl::Program& program) const;
+};
+
+}  // namespace eik::gpu

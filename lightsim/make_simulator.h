@@ -1,0 +1,38 @@
+// makeSimulator: the light simulator for a back end (`lightsim --backend gl|cpu|auto --gl ...`):
+//   Gl    the GPU particle system (gpu_simulator.h) in a context of the `gl` back end (or the
+//         current context, if one is);
+//   Cpu   the CPU twin (cpu_simulator.h);
+//   Auto  probes the OpenGL renderer: a hardware GPU gets the GPU path in the probed context; a
+//         software rasteriser (gl::isSoftwareRenderer: llvmpipe & co., where the twin is faster)
+//         or no OpenGL context at all gets the CPU twin. `report` is told the choice and why.
+// The caller runs the result through the Simulator interface only (simulator.h).
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "core/volume.h"
+#include "lightsim/simulator.h"
+
+namespace eik {
+
+enum class SimulatorBackend { Gl, Cpu, Auto };
+
+struct SimulatorBackendOptions {
+  SimulatorBackend backend = SimulatorBackend::Gl;
+  // The OpenGL back end for Gl and the Auto probe, as `--gl` names it: "auto", "osmesa" or "egl"
+  // (gl::parseGlBackend). Parsed only when OpenGL is used: a bad name is an InputError for Gl and,
+  // for Auto, a reason to take the CPU twin.
+  std::string gl = "auto";
+  std::string source = "volume";  // the manifest, for error messages (GpuSimulatorOptions::source)
+  // Auto only: told which back end was chosen and why, e.g. "llvmpipe (LLVM 15.0.6, 256 bits), so
+  // the CPU twin (faster than a software rasterizer)" or "no OpenGL context (...), so the CPU twin".
+  std::function<void(const std::string&)> report;
+};
+
+// The simulator for `volume` (see GpuSimulator's and CpuSimulator's constructors for what they
+// read and throw).
+std::unique_ptr<Simulator> makeSimulator(const Volume& volume, const SimulatorBackendOptions& options);
+
+}  // namespace eik

@@ -1,0 +1,21 @@
+// The run's constants as uniforms of the step passes (see step_uniforms.h).
+#include "lightsim/step_uniforms.h"
+
+#include "lightsim/wavefront.h"
+
+namespace eik::gpu {
+
+StepUniforms StepUniforms::from(const GridSpec& grid, const SimulationOptions& options, double fluxRef) {
+  StepUniforms step;
+  step.dt = static_cast<float>(timeStep(grid, options));
+  step.boundaryOn = static_cast<float>(options.boundary_on);
+  step.boundaryOff = static_cast<float>(options.boundary_off);
+  step.fluxKill = static_cast<float>(options.flux_threshold * fluxRef);
+  step.splitLength = static_cast<float>(splitThreshold(grid, options));  // split_voxels·h·(1 + margin)
+  step.maxDepth = static_cast<float>(options.max_depth);
+  step.axisSplit = options.split_rule == SplitRule::Axis;
+  step.killAtMaxDepth = options.at_max_depth == DepthLimit::Kill;
+  return step;
+}
+
+}  // namespace eik::gpu

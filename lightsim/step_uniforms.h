@@ -1,0 +1,26 @@
+// StepUniforms: the constants of a run as the step passes see them, in float: Δt and the boundary
+// thresholds g_on, g_off of the update pass (shaders/lightsim/update.frag, ALGORITHM.md steps 1–3),
+// and Δt, the kill threshold, the split length, the depth limit and the split rule of the analysis
+// pass (shaders/lightsim/fate.glsl, ALGORITHM.md step 5).
+#pragma once
+
+#include "core/grid.h"
+#include "lightsim/simulator.h"
+
+namespace eik::gpu {
+
+struct StepUniforms {
+  float dt = 0.0f;                              // Δt
+  float boundaryOn = 0.0f, boundaryOff = 0.0f;  // g_on, g_off
+  float fluxKill = 0.0f;                        // flux_threshold · Φ_ref
+  float splitLength = 0.0f;                     // split_voxels · h · (1 + margin)
+  float maxDepth = 0.0f;                        // max_depth
+  bool axisSplit = true;                        // SplitRule::Axis
+  bool killAtMaxDepth = false;                  // DepthLimit::Kill
+
+  // The uniforms of a run of `options` on `grid`, whose largest initial patch flux is Φ_ref =
+  // fluxRef (initialPatches): Δt = timeStep, the split length splitThreshold (wavefront.h).
+  static StepUniforms from(const GridSpec& grid, const SimulationOptions& options, double fluxRef);
+};
+
+}  // namespace eik::gpu

@@ -1,0 +1,43 @@
+// UpdatePass: ALGORITHM.md steps 1–3 for every live patch, one full-screen fragment pass over the
+// list's live box (viewportLiveBox) writing all eight patch textures at once (MRT).
+//
+//   shader   common/fullscreen.vert + shaders/lightsim/update.frag (with lightsim/fresnel.glsl),
+//            compiled for one integrator: INTEGRATOR_EULER (Eq. 6.1/6.2), _RK2 or _RK4
+//   step     1 update (§6.2.2): per corner x ← x + Δt·w/n², w ← w + Δt·∇n/n (or RK2/RK4), then
+//            |w| = n(x_new); 2 absorption Φ ← Φ·exp(−σa(m_old)·Δs_m); 3 Fresnel boundary
+//            tracking (enter a layer at g > g_on, leave it at g < g_off keeping 1 − R)
+//   in       list `in` (patches 0 .. count − 1), the volume's n, ∇n, σa, GridUniforms, and of
+//            StepUniforms Δt, g_on, g_off
+//   out      list `out` (the same patches, stepped; slots beyond count are left alone)
+//
+// The CPU twin of one patch is stepPatch (cpu_simulator.h), steps 1–3, with advanceCorner.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include "gl/program.h"
+#include "gl/shader_library.h"
+#include "gl/vertex_array.h"
+#include "gl/volume_textures.h"
+#include "lightsim/grid_uniforms.h"
+#include "lightsim/patch_textures.h"
+#include "lightsim/simulator.h"
+#include "lightsim/step_uniforms.h"
+
+namespace eik::gpu {
+
+class UpdatePass {
+ public:
+  // volumeDefines: the volume layout's GLSL defines (gl::VolumeLayout::glslDefines, plus
+  // EXACT_TRILINEAR when the shader samples the fields itself).
+  UpdatePass(const gl::ShaderLibrary& library, Integrator integrator, const std::string& volumeDefines);
+  void run(const PatchTextures& in, PatchTextures& out, std::size_t count, const gl::VolumeTextures& volume,
+           const GridUniforms& grid, const StepUniforms& step) const;
+
+ private:
+  gl::Program program_;
+  gl::FullscreenTriangle triangle_;
+};
+
+}  // namespace eik::gpu

@@ -1,0 +1,120 @@
+// The volume analysis of viewer/volume_analysis.h.
+#include "viewer/volume_analysis.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+
+namespace eik {
+
+bool activeRegion(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi) {
+  const GridSpec& grid = volume.grid;
+  const glm::ivec3 dims = grid.dims;
+  glm::ivec3 imin(dims), imax(-1);
+  auto mark = [&](std::size_t index) {
+    const int x = static_cast<int>(index % static_cast<std::size_t>(dims.x));
+    const int y = static_cast<int>((index / static_cast<std::size_t>(dims.x)) % static_cast<std::size_t>(dims.y));
+    const int z = static_cast<int>(index / (static_cast<std::size_t>(dims.x) * static_cast<std::size_t>(dims.y)));
+    imin = glm::min(imin, glm::ivec3(x, y, z));
+    imax = glm::max(imax, glm::ivec3(x, y, z));
+  };
+  const std::size_t count = grid.count();
+  const double h = std::min({grid.voxelSize().x, grid.voxelSize().y, grid.voxelSize().z});
+  auto scan = [&](const char* name, auto&& nontrivial) {
+    const Field* f = volume.find(name);
+    if (!f) return;
+    for (std::size_t i = 0; i < count; ++i)
+      if (nontrivial(f->voxel(i))) mark(i);
+  };
+  scan("ior", [](const float* v) { return std::abs(v[0] - 1.0f) > 1e-5f; });
+  scan("ior_grad", [&](const float* v) { return (std::abs(v[0]) + std::abs(v[1]) + std::abs(v[2])) * h > 1e-6; });
+  scan("sigma_a", [](const float* v) { return v[0] > 0 || v[1] > 0 || v[2] > 0; });
+  scan("emission", [](const float* v) { return v[0] > 0 || v[1] > 0 || v[2] > 0; });
+  scan("scatter", [](const float* v) { return v[0] > 0; });
+  scan("opaque", [](const float* v) { return v[3] > 0; });
+  if (imax.x < 0) return false;
+  const glm::dvec3 voxel = grid.voxelSize();
+  lo = glm::max(grid.bounds_min, grid.bounds_min + glm::dvec3(imin - 1) * voxel);
+  hi = glm::min(grid.bounds_max, grid.bounds_min + glm::dvec3(imax + 2) * voxel);
+  return true;
+}
+
+std::vector<float> homogeneousBricks(const Volume& volume, glm::ivec3& brick_dims) {
+  const GridSpec& grid = volume.grid;
+  const glm::ivec3 dims = grid.dims;
+  brick_dims = (dims + kBrickVoxels - 1) / kBrickVoxels;
+  const double h = std::min({grid.voxelSize().x, grid.voxelSize().y, grid.voxelSize().z});
+  const Field* ior = volume.find("ior");
+  const Field* grad = volume.find("ior_grad");
+  const Field* sigma = volume.find("sigma_a");
+  const Field* emission = volume.find("emission");
+  const Field* scatter = volume.find("scatter");
+  const Field* opaque = volume.find("opaque");
+  // Per voxel: does it break homogeneity by itself (∇n, emission, scattering, opaque)?
+  std::vector<unsigned char> busy(grid.count(), 0);
+  for (std::size_t i = 0; i < grid.count(); ++i) {
+    const float* g = grad->voxel(i);
+    bool b = (std::abs(g[0]) + std::abs(g[1]) + std::abs(g[2])) * h > 1e-4;
+    if (emission) b = b || emission->voxel(i)[0] > 0 || emission->voxel(i)[1] > 0 || emission->voxel(i)[2] > 0;
+    if (scatter) b = b || scatter->voxel(i)[0] > 0;
+    if (opaque) b = b || opaque->voxel(i)[3] > 0;
+    busy[i] = b;
+  }
+  std::vector<float> bricks(static_cast<std::size_t>(brick_dims.x) * brick_dims.y * brick_dims.z, 0.0f);
+  for (int bz = 0; bz < brick_dims.z; ++bz)
+    for (int by = 0; by < brick_dims.y; ++by)
+      for (int bx = 0; bx < brick_dims.x; ++bx) {
+        const glm::ivec3 lo = glm::max(glm::ivec3(bx, by, bz) * kBrickVoxels - kBrickMargin, glm::ivec3(0));
+        const glm::ivec3 hi = glm::min(glm::ivec3(bx, by, bz) * kBrickVoxels + kBrickVoxels + kBrickMargin, dims) - 1;
+        const std::size_t first = grid.index(lo.x, lo.y, lo.z);
+        bool homogeneous = true;
+        for (int k = lo.z; k <= hi.z && homogeneous; ++k)
+          for (int j = lo.y; j <= hi.y && homogeneous; ++j)
+            for (int i = lo.x; i <= hi.x && homogeneous; ++i) {
+              const std::size_t v = grid.index(i, j, k);
+              if (busy[v] || std::abs(ior->data[v] - ior->data[first]) > 1e-4f) homogeneous = false;
+              if (sigma)
+                for (int c = 0; c < 3; ++c)
+                  if (std::abs(sigma->voxel(v)[c] - sigma->voxel(first)[c]) > 1e-6f * (1.0f + sigma->voxel(first)[c]))
+                    homogeneous = false;
+            }
+        bricks[(static_cast<std::size_t>(bz) * brick_dims.y + by) * brick_dims.x + bx] = homogeneous ? 1.0f : 0.0f;
+      }
+  return bricks;
+}
+
+bool materialTouchesBox(const Volume& volume) {
+  const GridSpec& grid = volume.grid;
+  const Field* ior = volume.find("ior");
+  for (int k = 0; k < grid.dims.z; ++k)
+    for (int j = 0; j < grid.dims.y; ++j)
+      for (int i = 0; i < grid.dims.x; ++i) {
+        const bool face = i == 0 || j == 0 || k == 0 || i == grid.dims.x - 1 || j == grid.dims.y - 1 ||
+                          k == grid.dims.z - 1;
+        if (face && std::abs(ior->data[grid.index(i, j, k)] - 1.0f) > 1e-3f) return true;
+      }
+  return false;
+}
+
+bool absorbingRegion(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi) {
+  const Field* sigma = volume.find("sigma_a");
+  if (!sigma) return false;
+  const GridSpec& grid = volume.grid;
+  glm::ivec3 imin(grid.dims), imax(-1);
+  for (int k = 0; k < grid.dims.z; ++k)
+    for (int j = 0; j < grid.dims.y; ++j)
+      for (int i = 0; i < grid.dims.x; ++i) {
+        const float* v = sigma->voxel(grid.index(i, j, k));
+        if (v[0] > 0 || v[1] > 0 || v[2] > 0) {
+          imin = glm::min(imin, glm::ivec3(i, j, k));
+          imax = glm::max(imax, glm::ivec3(i, j, k));
+        }
+      }
+  if (imax.x < 0) return false;
+  const glm::dvec3 voxel = grid.voxelSize();
+  lo = glm::max(grid.bounds_min, grid.bounds_min + glm::dvec3(imin - 1) * voxel);
+  hi = glm::min(grid.bounds_max, grid.bounds_min + glm::dvec3(imax + 2) * voxel);
+  return true;
+}
+
+}  // namespace eik

@@ -1,0 +1,40 @@
+// What the viewer learns from a volume before it marches rays through it (no GL): the box where
+// something happens (empty-space skipping), the homogeneous bricks a ray may cross in one step,
+// whether the material touches the box (sharp faces) and the box where σa > 0. SceneRenderer
+// hands the results to shaders/viewer/object.glsl as uniforms, a texture and the SHARP_FACES
+// define. All boxes are in the volume's own coordinates.
+#pragma once
+
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/volume.h"
+
+namespace eik {
+
+// The box (in the volume's own coordinates) of the voxels where something happens: n ≠ 1, ∇n ≠ 0,
+// absorption, emission, scattering or an opaque embedding; one voxel of margin for the trilinear
+// filter. Outside it a ray goes straight and gathers nothing (empty-space skipping). Returns false
+// when the volume is empty throughout.
+bool activeRegion(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi);
+
+// Bricks of kBrickVoxels³ voxels where the medium is homogeneous: n constant and ∇n ≈ 0, σa
+// constant, no emission, scattering or opaque embedding, over the brick and kBrickMargin voxels
+// around it (the trilinear filter and the last step's reach). A ray crossing such a brick goes
+// straight, with T·exp(−σa·L): it crosses it in one step (thesis §6.3 leaves the step size free;
+// the thesis asks for skipping the interior of homogeneous glass). 1 = homogeneous, 0 = march.
+// Bricks x fastest, brick_dims = ⌈dims / kBrickVoxels⌉. Needs the ior and ior_grad fields.
+constexpr int kBrickVoxels = 4;
+constexpr int kBrickMargin = 2;
+std::vector<float> homogeneousBricks(const Volume& volume, glm::ivec3& brick_dims);
+
+// Whether the material touches the box: n ≠ 1 in a voxel of one of its faces. Such faces are sharp
+// interfaces (object.glsl, SHARP_FACES), as smoothing never saw the air beyond them. Needs ior.
+bool materialTouchesBox(const Volume& volume);
+
+// The box (volume coordinates) of the voxels with σa > 0, one voxel of margin; false when none.
+// Rays fetch σa only inside it (a second texture fetch a step is what absorption costs).
+bool absorbingRegion(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi);
+
+}  // namespace eik

@@ -1,0 +1,166 @@
+// The viewer's volume analysis on small hand-made volumes: the active region and the absorbing
+// region with their one-voxel margins (clamped to the box), the homogeneous bricks with their
+// margins, and whether the material touches the box.
+#include "viewer/volume_analysis.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+namespace eik {
+namespace {
+
+// dims voxels of size 1 from `origin`; air (n = 1, ∇n = 0) throughout.
+Volume air(glm::ivec3 dims, glm::dvec3 origin = glm::dvec3(0.0)) {
+  Volume v;
+  v.grid.dims = dims;
+  v.grid.bounds_min = origin;
+  v.grid.bounds_max = origin + glm::dvec3(dims);
+  v.addField("ior", 1).data.assign(v.grid.count(), 1.0f);
+  v.addField("ior_grad", 3);
+  return v;
+}
+
+float& ior(Volume& v, int i, int j, int k) { return v.fields.at("ior").data[v.grid.index(i, j, k)]; }
+float* field(Volume& v, const char* name, int i, int j, int k) {
+  return v.fields.at(name).voxel(v.grid.index(i, j, k));
+}
+
+void expectBox(const glm::dvec3& lo, const glm::dvec3& hi, glm::dvec3 want_lo, glm::dvec3 want_hi) {
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_DOUBLE_EQ(lo[c], want_lo[c]) << "lo[" << c << "]";
+    EXPECT_DOUBLE_EQ(hi[c], want_hi[c]) << "hi[" << c << "]";
+  }
+}
+
+float brick(const std::vector<float>& bricks, glm::ivec3 dims, int x, int y, int z) {
+  return bricks[(static_cast<std::size_t>(z) * dims.y + y) * dims.x + x];
+}
+
+TEST(ActiveRegion, IsFalseForAirThroughout) {
+  Volume v = air({6, 6, 6});
+  glm::dvec3 lo, hi;
+  EXPECT_FALSE(activeRegion(v, lo, hi));
+}
+
+TEST(ActiveRegion, IsTheNonTrivialVoxelsWithOneVoxelOfMargin) {
+  Volume v = air({8, 8, 8}, glm::dvec3(-4.0));
+  ior(v, 3, 4, 5) = 1.5f;                      // glass in one voxel
+  field(v, "ior_grad", 5, 4, 5)[1] = 0.01f;    // a gradient next to it, along x
+  glm::dvec3 lo, hi;
+  ASSERT_TRUE(activeRegion(v, lo, hi));
+  // Voxels x 3..5, y 4, z 5; their faces at origin + index, one voxel more on each side.
+  expectBox(lo, hi, glm::dvec3(-4.0) + glm::dvec3(2, 3, 4), glm::dvec3(-4.0) + glm::dvec3(7, 6, 7));
+}
+
+TEST(ActiveRegion, CountsEveryKindOfMediumAndClampsTheMarginToTheBox) {
+  Volume v = air({8, 8, 8});
+  v.addField("sigma_a", 3);
+  v.addField("emission", 3);
+  v.addField("scatter", 2);
+  v.addField("opaque", 4);
+  field(v, "sigma_a", 0, 0, 0)[2] = 0.1f;  // at the corner: the margin stops at the box
+  field(v, "emission", 7, 1, 1)[0] = 1.0f;
+  field(v, "scatter", 1, 7, 1)[0] = 0.5f;
+  field(v, "opaque", 1, 1, 6)[3] = 1.0f;
+  glm::dvec3 lo, hi;
+  ASSERT_TRUE(activeRegion(v, lo, hi));
+  expectBox(lo, hi, glm::dvec3(0.0), glm::dvec3(8, 8, 8));
+
+  Volume only_scatter = air({8, 8, 8});
+  only_scatter.addField("scatter", 2);
+  field(only_scatter, "scatter", 4, 4, 4)[1] = 0.9f;  // g without albedo scatters nothing
+  EXPECT_FALSE(activeRegion(only_scatter, lo, hi));
+}
+
+TEST(ActiveRegion, IgnoresIndicesAndGradientsWithinTheTolerance) {
+  Volume v = air({6, 6, 6});
+  ior(v, 2, 2, 2) = 1.0f + 5e-6f;               // |n − 1| ≤ 1e-5
+  field(v, "ior_grad", 3, 3, 3)[0] = 5e-7f;    // |∇n|·h ≤ 1e-6
+  glm::dvec3 lo, hi;
+  EXPECT_FALSE(activeRegion(v, lo, hi));
+}
+
+TEST(HomogeneousBricks, UniformGlassIsHomogeneousEverywhere) {
+  Volume v = air({9, 8, 4});
+  v.fields.at("ior").data.assign(v.grid.count(), 1.5f);
+  glm::ivec3 dims;
+  const std::vector<float> bricks = homogeneousBricks(v, dims);
+  EXPECT_EQ(dims, glm::ivec3(3, 2, 1));  // ⌈dims / 4⌉
+  ASSERT_EQ(bricks.size(), 6u);
+  for (float b : bricks) EXPECT_EQ(b, 1.0f);
+}
+
+TEST(HomogeneousBricks, AGradientMarksItsBrickAndTheNeighboursWithinTheMargin) {
+  Volume v = air({12, 4, 4});
+  field(v, "ior_grad", 5, 0, 0)[0] = 0.1f;  // in brick 1 (x 4..7), 1 voxel from brick 0, 2 from brick 2
+  glm::ivec3 dims;
+  const std::vector<float> bricks = homogeneousBricks(v, dims);
+  ASSERT_EQ(dims, glm::ivec3(3, 1, 1));
+  EXPECT_EQ(brick(bricks, dims, 0, 0, 0), 0.0f);  // brick 0 looks 2 voxels past x = 3: up to x = 5
+  EXPECT_EQ(brick(bricks, dims, 1, 0, 0), 0.0f);
+  EXPECT_EQ(brick(bricks, dims, 2, 0, 0), 1.0f);  // brick 2 looks back to x = 6 only
+}
+
+TEST(HomogeneousBricks, ChangesOfIndexOrAbsorptionAndMediaBreakHomogeneity) {
+  glm::ivec3 dims;
+  Volume step = air({8, 4, 4});
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 4; ++j)
+      for (int i = 6; i < 8; ++i) ior(step, i, j, k) = 1.5f;  // n jumps at x = 6 (no gradient stored)
+  std::vector<float> bricks = homogeneousBricks(step, dims);
+  EXPECT_EQ(brick(bricks, dims, 0, 0, 0), 1.0f);  // looks up to x = 5
+  EXPECT_EQ(brick(bricks, dims, 1, 0, 0), 0.0f);
+
+  Volume absorbing = air({8, 4, 4});
+  absorbing.addField("sigma_a", 3);
+  for (std::size_t i = 0; i < absorbing.grid.count(); ++i) absorbing.fields.at("sigma_a").voxel(i)[0] = 2.0f;
+  bricks = homogeneousBricks(absorbing, dims);
+  EXPECT_EQ(brick(bricks, dims, 0, 0, 0), 1.0f);  // constant σa is homogeneous
+  field(absorbing, "sigma_a", 1, 1, 1)[1] = 0.5f;
+  bricks = homogeneousBricks(absorbing, dims);
+  EXPECT_EQ(brick(bricks, dims, 0, 0, 0), 0.0f);
+  EXPECT_EQ(brick(bricks, dims, 1, 0, 0), 1.0f);  // x = 1 is 3 voxels before brick 1
+
+  for (const char* name : {"emission", "scatter", "opaque"}) {
+    Volume medium = air({8, 4, 4});
+    const int components = name == std::string("emission") ? 3 : name == std::string("scatter") ? 2 : 4;
+    medium.addField(name, components);
+    field(medium, name, 7, 3, 3)[components == 4 ? 3 : 0] = 1.0f;
+    bricks = homogeneousBricks(medium, dims);
+    EXPECT_EQ(brick(bricks, dims, 0, 0, 0), 1.0f) << name;
+    EXPECT_EQ(brick(bricks, dims, 1, 0, 0), 0.0f) << name;
+  }
+}
+
+TEST(MaterialTouchesBox, OnlyWhereNDiffersFromOneOnAFace) {
+  Volume v = air({6, 6, 6});
+  for (int k = 1; k < 5; ++k)
+    for (int j = 1; j < 5; ++j)
+      for (int i = 1; i < 5; ++i) ior(v, i, j, k) = 1.5f;  // glass inside, air on every face
+  EXPECT_FALSE(materialTouchesBox(v));
+  ior(v, 3, 5, 2) = 1.0005f;  // within 1e-3 of air
+  EXPECT_FALSE(materialTouchesBox(v));
+  ior(v, 3, 5, 2) = 1.5f;  // on the top face
+  EXPECT_TRUE(materialTouchesBox(v));
+  Volume w = air({6, 6, 6});
+  ior(w, 0, 2, 2) = 1.2f;  // on the x = 0 face
+  EXPECT_TRUE(materialTouchesBox(w));
+}
+
+TEST(AbsorbingRegion, IsTheBoxOfPositiveSigmaWithOneVoxelOfMargin) {
+  glm::dvec3 lo, hi;
+  Volume v = air({8, 8, 8}, glm::dvec3(1.0, 2.0, 3.0));
+  EXPECT_FALSE(absorbingRegion(v, lo, hi));  // no sigma_a field
+  v.addField("sigma_a", 3);
+  EXPECT_FALSE(absorbingRegion(v, lo, hi));  // all zero
+  field(v, "sigma_a", 2, 3, 4)[0] = 0.5f;
+  field(v, "sigma_a", 4, 3, 7)[1] = 0.5f;  // at the last z layer: the margin stops at the box
+  ior(v, 0, 0, 0) = 1.5f;                  // glass does not absorb
+  ASSERT_TRUE(absorbingRegion(v, lo, hi));
+  expectBox(lo, hi, glm::dvec3(1.0, 2.0, 3.0) + glm::dvec3(1, 2, 3), glm::dvec3(1.0, 2.0, 3.0) + glm::dvec3(6, 5, 8));
+}
+
+}  // namespace
+}  // namespace eik
