@@ -129,10 +129,8 @@ gl::ShaderSource raymarchFragmentSource(const gl::ShaderLibrary& shaders, const 
       scope += "#define " + gl::VolumeTextureLayout::samplerName(t) + " " + objectTextureSampler(k, t) + "\n";
     for (const std::string& function : accessor_functions) scope += "#define " + function + " " + function + index + "\n";
     scope += objects[k].layout.glslDefines();
-    const std::vector<std::string> names = definedNames(scope);
-    // Not #undef'd with the rest: the objects after this one keep SHARP_FACES (as the renderer
-    // has always assembled it).
     if (objects[k].sharp_faces) scope += "#define SHARP_FACES 1\n";
+    const std::vector<std::string> names = definedNames(scope);
 
     out += scope;
     out += "#line 1 " + std::to_string(source.files.size()) + "\n";

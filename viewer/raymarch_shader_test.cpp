@@ -125,8 +125,11 @@ TEST(RaymarchShader, ThreeObjectsEachInItsOwnScope) {
   EXPECT_GT(text.find("#define HAS_DISPERSION 1\n"), march1);
   EXPECT_CONTAINS(text, "#define uVolumeTex4 uO1Tex4\n");  // optics, absorption, scatter, irradiance, light_dir
   EXPECT_EQ(occurrences(text, "#define uVolumeTex4 "), 1u);
-  const std::size_t sharp = text.find("#define SHARP_FACES 1\n");
-  EXPECT_TRUE(march0 < sharp && sharp < march1);
+  // Sharp faces belong to object 1 only: object 2 (whose material keeps clear of its box) must not
+  // inherit them.
+  const std::size_t sharp = text.find("#define SHARP_FACES 1\n"), sharp_end = text.find("#undef SHARP_FACES\n");
+  EXPECT_TRUE(march0 < sharp && sharp < march1 && march1 < sharp_end && sharp_end < march2);
+  EXPECT_EQ(occurrences(text, "#define SHARP_FACES 1\n"), 1u);
   EXPECT_EQ(objectTextureSampler(2, 1), "uO2Tex1");
 
   // Compiler messages name each instance, and raymarch.frag's numbering resumes after them.
