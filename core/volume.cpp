@@ -24,7 +24,8 @@ namespace {
 constexpr std::string_view kFormat = "eikonal-volume";
 constexpr int kVersion = 1;
 // Manifest keys writeVolume owns; metadata cannot overwrite them.
-constexpr std::string_view kReservedKeys[] = {"format", "version", "dims", "bounds_min", "bounds_max", "fields"};
+constexpr std::string_view kReservedKeys[] = {"format",     "version", "dims",     "bounds_min",
+                                             "bounds_max", "fields",  "receivers"};
 
 bool isReserved(std::string_view key) {
   for (std::string_view reserved : kReservedKeys) {
@@ -127,10 +128,44 @@ class ManifestReader {
       }
     }
 
+    readReceivers(root, volume, with_data);
+
     for (const auto& [key, value] : root.items()) {
       if (!isReserved(key)) volume.metadata[key] = value;
     }
     return volume;
+  }
+
+  // The "receivers" table and, with data, each map's NRRD.
+  void readReceivers(const nlohmann::json& root, Volume& volume, bool with_data) {
+    auto receivers = root.find("receivers");
+    if (receivers == root.end()) return;
+    if (!receivers->is_array()) throw InputError(name_, "receivers", "expected an array");
+    for (std::size_t i = 0; i < receivers->size(); ++i) {
+      const std::string key = "receivers[" + std::to_string(i) + "]";
+      std::string file;
+      ReceiverMap map = receiverFromJson((*receivers)[i], name_, key, file);
+      fs::path path(file);
+      if (path.is_relative()) path = manifest_.parent_path() / path;
+      std::error_code ec;
+      if (!fs::is_regular_file(path, ec)) throw InputError(name_, key + ".file", path.string() + ": not found");
+      NrrdHeader header;
+      try {
+        header = readNrrdHeader(path);
+      } catch (const InputError& e) {
+        throw InputError(name_ + ": " + key + ": " + e.what());
+      }
+      checkReceiverHeader(map, header, name_, key, path.string());
+      if (with_data) {
+        checkMemoryLimit(name_, key, fieldBytes(header.sizes, header.components));
+        try {
+          map.irradiance = readNrrd(path).data;
+        } catch (const InputError& e) {
+          throw InputError(name_ + ": " + key + ": " + e.what());
+        }
+      }
+      volume.receivers.push_back(std::move(map));
+    }
   }
 
  private:
@@ -315,7 +350,7 @@ class ManifestReader {
 
 const std::vector<FieldSpec>& knownFields() {
   static const std::vector<FieldSpec> fields = {
-      {"ior", 1, "refractive index n after pre-smoothing (1 = vacuum/air)"},
+      {"ior", 1, "refractive index n (pre-smoothed, or sharp with an interfaces field)"},
       {"ior_grad", 3, "gradient of n in 1/world-unit (central differences of the smoothed n)"},
       {"sigma_a", 3, "RGB absorption (attenuation) coefficient"},
       {"emission", 3, "RGB emitted radiance L_e"},
@@ -325,6 +360,7 @@ const std::vector<FieldSpec>& knownFields() {
       {"dispersion", 1, "Cauchy B (um^2): n(lambda) = n + B (1/lambda^2 - 1/lambda_d^2)"},
       {"irradiance", 3, "baked RGB irradiance (from lightsim)"},
       {"light_dir", 3, "baked unit local light direction (from lightsim)"},
+      {"interfaces", 4, "signed distance to the surface of each interface slot (negative inside)"},
   };
   return fields;
 }
@@ -414,6 +450,18 @@ void writeVolume(const Volume& volume, const fs::path& manifest, const VolumeWri
     table[field_name] = {{"file", file.filename().string()}, {"components", field.components}};
   }
 
+  nlohmann::ordered_json receivers = nlohmann::ordered_json::array();
+  for (const ReceiverMap& map : volume.receivers) {
+    if (!isValidFieldName(map.name))
+      throw RuntimeError(name + ": receivers." + map.name + ": a receiver name may hold only letters, digits, '_' and '-'");
+    if (map.irradiance.size() != map.texelCount() * 3)
+      throw RuntimeError(name + ": receivers." + map.name + ": " + std::to_string(map.irradiance.size()) +
+                         " values for " + std::to_string(map.texelCount()) + " RGB texels");
+    fs::path file = dir / (stem + ".receiver-" + map.name + (options.detached ? ".nhdr" : ".nrrd"));
+    stageNrrd(files, file, map.nrrdHeader(), map.irradiance, {options.gzip, options.detached});
+    receivers.push_back(nlohmann::ordered_json::parse(map.toJson(file.filename().string()).dump()));
+  }
+
   nlohmann::ordered_json json = nlohmann::ordered_json::object();
   json["format"] = kFormat;
   json["version"] = kVersion;
@@ -421,6 +469,7 @@ void writeVolume(const Volume& volume, const fs::path& manifest, const VolumeWri
   json["bounds_min"] = {grid.bounds_min.x, grid.bounds_min.y, grid.bounds_min.z};
   json["bounds_max"] = {grid.bounds_max.x, grid.bounds_max.y, grid.bounds_max.z};
   json["fields"] = std::move(table);
+  if (!receivers.empty()) json["receivers"] = std::move(receivers);
   if (volume.metadata.is_object()) {
     for (const auto& [key, value] : volume.metadata.items()) {
       if (!isReserved(key)) json[key] = nlohmann::ordered_json::parse(value.dump());

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/grid.h"
+#include "core/receiver_map.h"
 
 namespace eik {
 
@@ -40,6 +41,8 @@ struct Field {
 struct Volume {
   GridSpec grid;
   std::map<std::string, Field> fields;
+  // Receiver maps baked onto planes (core/receiver_map.h), written beside the fields.
+  std::vector<ReceiverMap> receivers;
   // Further manifest entries carried through unchanged: "light", "bake_stats", "materials",
   // "source", ... (everything but the reserved keys written by writeVolume).
   nlohmann::json metadata = nlohmann::json::object();

@@ -68,7 +68,7 @@ std::string manifestError(const TempDir& dir) {
 // ---------------------------------------------------------------------------------------------
 
 TEST(Volume, KnownFieldsTable) {
-  EXPECT_EQ(knownFields().size(), 10u);
+  EXPECT_EQ(knownFields().size(), 11u);
   EXPECT_EQ(knownFieldComponents("ior"), 1);
   EXPECT_EQ(knownFieldComponents("ior_grad"), 3);
   EXPECT_EQ(knownFieldComponents("sigma_a"), 3);
@@ -79,6 +79,7 @@ TEST(Volume, KnownFieldsTable) {
   EXPECT_EQ(knownFieldComponents("dispersion"), 1);
   EXPECT_EQ(knownFieldComponents("irradiance"), 3);
   EXPECT_EQ(knownFieldComponents("light_dir"), 3);
+  EXPECT_EQ(knownFieldComponents("interfaces"), 4);
   EXPECT_EQ(knownFieldComponents("something_else"), 0);
 }
 

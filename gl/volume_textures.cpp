@@ -28,6 +28,7 @@ const std::vector<GroupSpec>& groups() {
       {"light_dir", {{"light_dir", 3}}},
       {"opaque", {{"opaque", 4}}},
       {"reflect", {{"reflect", 4}}},
+      {"interfaces", {{"interfaces", 4}}},
   };
   return table;
 }

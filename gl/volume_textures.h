@@ -11,6 +11,7 @@
 //   light_dir   light_dir (rgb)
 //   opaque      opaque (rgba)
 //   reflect     reflect (rgba)
+//   interfaces  interfaces (rgba)                crossing sharp interfaces (core/interfaces.h)
 //
 // Groups with no field present are dropped and the rest numbered 0, 1, ...; within a group the
 // fields present take consecutive channels in the order above (ior_grad alone is rgb). Each

@@ -53,9 +53,14 @@ nlohmann::json SimulationStats::toJson() const {
   j["peak_patches"] = peak_patches;
   j["total_patches"] = total_patches;
   j["splits"] = splits;
-  j["kills"] = {{"flux", kills.flux}, {"exited", kills.exited}, {"folded", kills.folded}, {"depth", kills.depth}};
-  // The energy ledger: flux_in = out + absorbed + reflected + killed + unfinished (W, RGB).
-  const glm::dvec3 accounted = flux_out + flux_absorbed + flux_reflected + flux_killed + flux_unfinished;
+  j["kills"] = {{"flux", kills.flux},         {"exited", kills.exited},     {"folded", kills.folded},
+                {"depth", kills.depth},       {"received", kills.received}, {"blocked", kills.blocked}};
+  j["reflections"] = reflections;
+  j["rollbacks"] = rollbacks;
+  // The energy ledger: flux_in = out + absorbed + reflected + killed + unfinished + received +
+  // blocked (W, RGB).
+  const glm::dvec3 accounted =
+      flux_out + flux_absorbed + flux_reflected + flux_killed + flux_unfinished + flux_received + flux_blocked;
   const double scale = std::max(std::fabs(flux_in.x), std::max(std::fabs(flux_in.y), std::fabs(flux_in.z)));
   const glm::dvec3 residual = flux_in - accounted;
   const double worst = std::max(std::fabs(residual.x), std::max(std::fabs(residual.y), std::fabs(residual.z)));
@@ -65,6 +70,8 @@ nlohmann::json SimulationStats::toJson() const {
                {"reflected", vec3Json(flux_reflected)},
                {"killed", vec3Json(flux_killed)},
                {"unfinished", vec3Json(flux_unfinished)},
+               {"received", vec3Json(flux_received)},
+               {"blocked", vec3Json(flux_blocked)},
                {"ledger_relative_residual", scale > 0.0 ? worst / scale : 0.0}};
   j["phase_seconds"] = nlohmann::json::object();
   for (const auto& [name, seconds] : phase_seconds) j["phase_seconds"][name] = seconds;
@@ -88,6 +95,7 @@ void applyBake(Volume& volume, const BakeResult& result, const LightSpec& light)
   check(result.light_dir, "light_dir");
   volume.fields["irradiance"] = result.irradiance;
   volume.fields["light_dir"] = result.light_dir;
+  volume.receivers = result.receivers;
   volume.metadata["light"] = light.toJson();
   volume.metadata["bake_stats"] = result.stats.toJson();
 }
@@ -142,6 +150,41 @@ LightSpec lightFromScene(const std::filesystem::path& file) {
   if (!(light.power.x > 0 || light.power.y > 0 || light.power.z > 0))
     throw InputError(file.string(), "lights[0]", "the light has no power");
   return light;
+}
+
+ReceiverSpec parseReceiver(const std::string& text) {
+  ReceiverSpec spec;
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  for (std::size_t colon; (colon = text.find(':', start)) != std::string::npos; start = colon + 1)
+    parts.push_back(text.substr(start, colon - start));
+  parts.push_back(text.substr(start));
+  if (parts.size() < 2 || parts.size() > 3)
+    throw InputError("--receiver", "", "'" + text + "': expected PX,PY,PZ:NX,NY,NZ[:HALF_EXTENT]");
+  const std::vector<double> p = parseNumbers(parts[0], "--receiver", "point");
+  const std::vector<double> n = parseNumbers(parts[1], "--receiver", "normal");
+  if (p.size() != 3 || n.size() != 3) throw InputError("--receiver", "", "'" + text + "': expected three numbers for P and N");
+  spec.point = glm::dvec3(p[0], p[1], p[2]);
+  const glm::dvec3 normal(n[0], n[1], n[2]);
+  const double len = glm::length(normal);
+  if (!(len > 0.0) || !std::isfinite(len)) throw InputError("--receiver", "normal", "'" + text + "': must not be zero");
+  spec.normal = normal / len;
+  if (parts.size() == 3) {
+    const std::vector<double> e = parseNumbers(parts[2], "--receiver", "half extent");
+    if (e.size() != 1 || !(e[0] > 0.0)) throw InputError("--receiver", "half extent", "'" + text + "': must be positive");
+    spec.half_extent = e[0];
+  }
+  return spec;
+}
+
+std::optional<ReceiverSpec> receiverFromScene(const std::filesystem::path& file) {
+  const Scene scene = readScene(file);
+  if (!scene.ground) return std::nullopt;
+  ReceiverSpec spec;
+  spec.point = scene.ground->point;
+  spec.normal = glm::normalize(scene.ground->normal);
+  spec.half_extent = scene.ground->half_extent;
+  return spec;
 }
 
 }  // namespace eik

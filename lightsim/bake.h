@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "core/volume.h"
@@ -31,6 +32,13 @@ LightSpec parseLight(const std::string& light, const std::string& power = "1,1,1
 // The first light of a SCENE.json (`lightsim --scene`), as a LightSpec. Throws InputError naming
 // the file for a scene without lights or a light without power (and what readScene throws).
 LightSpec lightFromScene(const std::filesystem::path& file);
+
+// Parses `--receiver` ("PX,PY,PZ:NX,NY,NZ[:HALF_EXTENT]"): the plane through P with normal N
+// (normalised), and its half extent (default unbounded). InputError naming --receiver otherwise.
+ReceiverSpec parseReceiver(const std::string& text);
+
+// The ground of a SCENE.json as a receiver (`lightsim --scene`), or nullopt when it has none.
+std::optional<ReceiverSpec> receiverFromScene(const std::filesystem::path& file);
 
 // True when the bake had no initial patch: the light misses the volume (the bake is all zeros).
 inline bool lightMissedVolume(const SimulationStats& stats) { return stats.initial_patches == 0; }

@@ -26,6 +26,9 @@
 #include <vector>
 
 #include "core/parallel.h"
+#include "lightsim/interface_crossing.h"
+#include "lightsim/receiver.h"
+#include "lightsim/track_deposit.h"
 #include "core/stopwatch.h"
 
 namespace eik {
@@ -96,26 +99,136 @@ PatchSamples samplePatch(const Patch& patch, const VolumeSampler& sampler) {
   return s;
 }
 
+StepContext makeStepContext(const VolumeSampler& sampler, const SimulationOptions& options, double flux_ref) {
+  StepContext ctx;
+  ctx.sampler = &sampler;
+  ctx.options = &options;
+  ctx.dt = timeStep(sampler.grid(), options);
+  ctx.flux_ref = flux_ref;
+  ctx.voxel_volume = sampler.grid().voxelVolume();
+  propagationBox(sampler.grid(), options, ctx.box_lo, ctx.box_hi);
+  return ctx;
+}
+
 PatchStepResult stepPatch(Patch& patch, const StepContext& ctx) {
   PatchSamples samples = samplePatch(patch, *ctx.sampler);
   return stepPatch(patch, samples, ctx);
 }
+
+namespace {
+
+// A step that would tear a patch (its edges past this many split lengths after crossing an
+// interface) is undone and the patch split before it crosses (ALGORITHM.md "Sharp interfaces").
+constexpr double kTearFactor = 2.0;
+// Total internal reflections (all corners together) after which a patch counts as trapped and dies:
+// on a voxelised sphere the rays that enter at grazing incidence can meet the far side just past
+// the critical angle and circle inside it for ever.
+constexpr int kMaxTotalReflections = 16;
+
+bool oneMedium(const Patch& p) {
+  return p.medium[0] == p.medium[1] && p.medium[1] == p.medium[2] && p.medium[2] == p.medium[3];
+}
+
+// The sub-path lattice of a patch (track_deposit.h): ≤ ½ voxel between neighbours along u and v.
+glm::ivec2 subPathLattice(const Patch& before, const Patch& after, double h) {
+  auto longest = [](const Patch& p, int a, int b, int c, int d) {
+    return std::max(glm::length(p.x[b] - p.x[a]), glm::length(p.x[c] - p.x[d]));
+  };
+  const double u = std::max(longest(before, 0, 1, 2, 3), longest(after, 0, 1, 2, 3));
+  const double v = std::max(longest(before, 1, 2, 3, 0), longest(after, 1, 2, 3, 0));
+  return {trackLattice(u / h), trackLattice(v / h)};
+}
+
+// Step 1 with sharp interfaces: every corner crosses the interfaces on its way. Returns the
+// patch's flux transmittance Π (1 − R_c)^¼ and whether any corner met an interface; `blocked`
+// counts the corners an opaque surface stopped, `transmitted` the corners that refracted.
+struct SharpUpdate {
+  double transmittance = 1.0;
+  bool met_interface = false;
+  int blocked = 0;
+  int transmitted_mask = 0;
+  int met_mask = 0;        // corners that met an interface (refracted, reflected or were stopped)
+  int reflections = 0;     // total internal reflections, all corners
+};
+SharpUpdate updateCornersSharp(Patch& patch, PatchSamples& samples, const StepContext& ctx) {
+  SharpUpdate u;
+  for (int c = 0; c < 4; ++c) {
+    const CornerCrossings cc = advanceCornerSharp(patch.x[c], patch.w[c], patch.medium[c], samples.corner[c], ctx.dt,
+                                                  ctx.options->integrator, *ctx.sampler);
+    const bool met = cc.transmitted > 0 || cc.reflected > 0 || cc.blocked;
+    u.met_interface |= met;
+    if (met) u.met_mask |= 1 << c;
+    u.reflections += cc.reflected;
+    u.blocked += cc.blocked ? 1 : 0;
+    if (cc.transmitted > 0) u.transmitted_mask |= 1 << c;
+    u.transmittance *= std::pow(cc.transmittance, 0.25);
+  }
+  return u;
+}
+
+// A patch meets an interface with some corners and not yet with the others. It will tear — the
+// others pass the object by (its silhouette), or meet another surface — unless each of them finds
+// the surface just crossed ahead on its straight ray, within a few patch sizes.
+bool willTear(const Patch& patch, const SharpUpdate& u, const VolumeSampler& sampler, double reach) {
+  int slot = -1;
+  for (int c = 0; c < 4; ++c) {
+    if (u.met_mask & (1 << c)) continue;
+    InterfaceHit hit;
+    const glm::dvec3 d = glm::normalize(patch.w[c]);
+    if (!findInterface(sampler, patch.x[c], patch.x[c] + reach * d, patch.medium[c], hit)) return true;
+    if (slot >= 0 && hit.slot != slot) return true;
+    slot = hit.slot;
+  }
+  return false;
+}
+
+}  // namespace
 
 PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext& ctx) {
   const VolumeSampler& sampler = *ctx.sampler;
   const SimulationOptions& options = *ctx.options;
   const GridSpec& grid = sampler.grid();
   const double h = sampler.h();
+  const double threshold = splitThreshold(grid, options);
+  const bool sharp = sampler.sharp();
+  const bool track = options.deposit == DepositMode::Accumulate && options.deposit_kernel == DepositKernel::Track;
   PatchStepResult result;
 
+  const Patch before = patch;
   const glm::dvec3 m_old = patch.midpoint();
   const glm::dvec3 d_old = patch.direction();
   const double n_m_old = samples.n_mid;
   const double ds = ctx.dt / n_m_old;  // Δs_m = Δt/n(m) (Eq. 4.11)
 
-  // 1. Update (§6.2.2, Eq. 6.1/6.2 or RK2/RK4), then |w| = n(x_new).
-  for (int c = 0; c < 4; ++c)
-    advanceCorner(patch.x[c], patch.w[c], samples.corner[c], ctx.dt, options.integrator, sampler);
+  // 1. Update (§6.2.2, Eq. 6.1/6.2 or RK2/RK4), then |w| = n(x_new); with sharp interfaces, Snell
+  //    and Fresnel where a corner crosses one.
+  SharpUpdate crossing;
+  if (sharp) {
+    const PatchSamples samples_before = samples;
+    crossing = updateCornersSharp(patch, samples, ctx);
+    // A tear: undo the step and split the patch as it was, so that its parts cross on their own.
+    // Either the step stretched it far, or it is the patch's first touch of an interface and some
+    // corners will not follow (willTear).
+    patch.reflections += crossing.reflections;
+    if (crossing.met_interface && patch.depth < options.max_depth && oneMedium(before)) {
+      const bool stretched = splitAxes(patch, kTearFactor * threshold, options.split_rule).any();
+      const bool first_touch = crossing.met_mask != 0xF;
+      const bool tears = stretched || (first_touch && willTear(patch, crossing, sampler, 4.0 * std::max(patch.longestEdge(), h)));
+      if (tears) {
+        SplitAxes axes = splitAxes(patch, threshold, options.split_rule);
+        if (!axes.any()) axes = splitAxes(before, 0.0, options.split_rule);  // a tear ahead: halve it
+        patch = before;
+        samples = samples_before;
+        result.rolled_back = true;
+        result.fate = PatchFate::Split;
+        result.split = axes;
+        return result;
+      }
+    }
+  } else {
+    for (int c = 0; c < 4; ++c)
+      advanceCorner(patch.x[c], patch.w[c], samples.corner[c], ctx.dt, options.integrator, sampler);
+  }
 
   // 2. Absorption at the old midpoint: Φ ← Φ·exp(−σa(m)·Δs_m) (Beer–Lambert).
   if (sampler.hasAbsorption()) {
@@ -125,54 +238,115 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
     patch.flux *= transmitted;
   }
 
-  // 3. Fresnel at boundary layers (docs/physics.md; fresnelReflectance, wavefront.h).
+  // 3. Fresnel: at the sharp interfaces the corners crossed, or at the boundary layer of a
+  //    smoothed n (docs/physics.md).
   const glm::dvec3 m_new = patch.midpoint();
   const glm::dvec3 d_new = patch.direction();
-  const glm::dvec4 ng = sampler.iorAndGradient(m_new);
-  samples.n_mid = ng.x;
-  const glm::dvec3 grad(ng.y, ng.z, ng.w);
-  const double grad_len = glm::length(grad);
-  const double g = grad_len * h;  // index change per voxel
-  patch.t_fresnel = 1.0;
-  if (patch.n_in == 0.0 && g > options.boundary_on) {
-    patch.n_in = n_m_old;
-    patch.cos_in = std::fabs(glm::dot(d_old, grad / grad_len));
-  } else if (patch.n_in != 0.0 && g < options.boundary_off) {
-    const double cos_out = grad_len > 0.0 ? std::fabs(glm::dot(d_new, grad / grad_len)) : -1.0;
-    const double reflectance = boundaryReflectance(patch.n_in, patch.cos_in, ng.x, cos_out, options.boundary_off);
-    result.reflected = patch.flux * reflectance;
-    patch.flux *= 1.0 - reflectance;
-    patch.t_fresnel = 1.0 - reflectance;
-    patch.n_in = 0.0;
+  if (sharp) {
+    samples.n_mid = sampler.materialOptics(sampler.materialAt(m_new), m_new).x;
+    patch.t_fresnel = crossing.transmittance;
+    if (crossing.transmittance < 1.0) {
+      result.reflected = patch.flux * (1.0 - crossing.transmittance);
+      patch.flux *= crossing.transmittance;
+      patch.reflect_pending = 1.0 - (1.0 - patch.reflect_pending) * crossing.transmittance;
+    }
+    patch.crossed |= crossing.transmitted_mask;
+    if (patch.crossed == 0xF) {
+      // Every corner is through: the reflected wavefront leaves the interface now (bounces).
+      const glm::dvec3 reflected_flux = patch.flux * (patch.reflect_pending / (1.0 - patch.reflect_pending));
+      if (patch.bounce < options.bounces && patch.reflect_pending > 0.0 && patch.reflect_pending < 1.0 &&
+          std::max(reflected_flux.x, std::max(reflected_flux.y, reflected_flux.z)) >=
+              fluxKillThreshold(ctx.flux_ref, options, static_cast<int>(patch.depth)) &&
+          reflectedPatch(patch, sampler, 4.0 * ctx.dt + 2.0 * h, result.reflection)) {
+        result.spawn_reflection = true;
+        result.reflection.flux = reflected_flux;
+        result.reflection.area0 = result.reflection.area();
+        result.reflection.bounce = patch.bounce + 1;
+        result.reflection.reflect_pending = 0.0;
+        result.reflection.crossed = 0;
+        result.reflection.t_fresnel = 1.0;
+      }
+      patch.crossed = 0;
+      patch.reflect_pending = 0.0;
+    }
+  } else {
+    const glm::dvec4 ng = sampler.iorAndGradient(m_new);
+    samples.n_mid = ng.x;
+    const glm::dvec3 grad(ng.y, ng.z, ng.w);
+    const double grad_len = glm::length(grad);
+    const double g = grad_len * h;  // index change per voxel
+    patch.t_fresnel = 1.0;
+    if (patch.n_in == 0.0 && g > options.boundary_on) {
+      patch.n_in = n_m_old;
+      patch.cos_in = std::fabs(glm::dot(d_old, grad / grad_len));
+    } else if (patch.n_in != 0.0 && g < options.boundary_off) {
+      const double cos_out = grad_len > 0.0 ? std::fabs(glm::dot(d_new, grad / grad_len)) : -1.0;
+      const double reflectance = boundaryReflectance(patch.n_in, patch.cos_in, ng.x, cos_out, options.boundary_off);
+      result.reflected = patch.flux * reflectance;
+      patch.flux *= 1.0 - reflectance;
+      patch.t_fresnel = 1.0 - reflectance;
+      patch.n_in = 0.0;
+    }
   }
 
-  // 4. Deposit record (§6.2.3): the voxel of the new midpoint, only inside the grid.
+  // The receiver: the patch's midpoint crossed the plane in this step, or it left the box towards it.
+  const ReceiverMap* receiver = ctx.receiver;
+  const bool inside = insideBox(m_new, ctx.box_lo, ctx.box_hi);
+  bool reached = false;
+  if (receiver) {
+    const double above_old = glm::dot(m_old - receiver->point, receiver->normal);
+    const double above_new = glm::dot(m_new - receiver->point, receiver->normal);
+    const bool crossed_plane = above_old > 0.0 && above_new <= 0.0;
+    const bool heading_there = !inside && !rayHitsBox(m_new, d_new, ctx.box_lo, ctx.box_hi) && above_new > 0.0 &&
+                               glm::dot(d_new, receiver->normal) < 0.0;
+    reached = (crossed_plane || heading_there) && patchFootprint(patch, *receiver, result.footprint);
+  }
+
+  // 4. Deposit record (§6.2.3).
   const glm::dvec3 N = patch.areaVector();
-  result.voxel = containingVoxel(grid, m_new);
-  if (result.voxel >= 0) {
-    if (options.deposit == DepositMode::Accumulate) {
-      result.deposit = patch.flux * (ds / ctx.voxel_volume);
-      result.deposit_dir = (luminance(patch.flux) * ds) * d_new;
-    } else {
-      const double area = glm::length(N);
-      result.deposit = area > 0.0 ? patch.flux / area : glm::dvec3(0.0);
-      result.deposit_dir = d_new;
-      result.max_key = luminance(result.deposit);
+  if (track) {
+    result.track = true;
+    result.from = before.x;
+    result.track_flux = 0.5 * (before.flux + patch.flux);  // the flux along the step (trapezoid)
+    result.lattice = subPathLattice(before, patch, h);
+    result.clip_to_receiver = reached;
+  } else {
+    result.voxel = containingVoxel(grid, m_new);
+    if (result.voxel >= 0) {
+      if (options.deposit == DepositMode::Accumulate) {
+        result.deposit = patch.flux * (ds / ctx.voxel_volume);
+        result.deposit_dir = (luminance(patch.flux) * ds) * d_new;
+      } else {
+        const double area = glm::length(N);
+        result.deposit = area > 0.0 ? patch.flux / area : glm::dvec3(0.0);
+        result.deposit_dir = d_new;
+        result.max_key = luminance(result.deposit);
+      }
     }
   }
 
   // 5. Analysis (§6.2.4).
-  if (maxChannel(patch.flux) < fluxKillThreshold(ctx.flux_ref, options, patch.depth)) {
+  if (reached) {
+    result.fate = PatchFate::Received;
+    result.received = patch.flux;
+  } else if (crossing.blocked >= 2) {
+    result.fate = PatchFate::Blocked;
+  } else if (patch.reflections > kMaxTotalReflections) {
+    result.fate = PatchFate::KilledDepth;  // trapped by total internal reflection (a whispering gallery)
+  } else if (maxChannel(patch.flux) < fluxKillThreshold(ctx.flux_ref, options, patch.depth)) {
     result.fate = PatchFate::KilledFlux;
-  } else if (!insideBox(m_new, grid.bounds_min, grid.bounds_max) &&
-             !rayHitsBox(m_new, d_new, grid.bounds_min, grid.bounds_max)) {
+  } else if (!inside && !rayHitsBox(m_new, d_new, ctx.box_lo, ctx.box_hi)) {
     result.fate = PatchFate::Exited;
   } else if (options.deposit == DepositMode::Max && !(glm::dot(N, d_new) > 0.0)) {
     result.fate = PatchFate::Folded;  // orientation flipped: a caustic singularity
-  } else if ((result.split = splitAxes(patch, splitThreshold(grid, options), options.split_rule)).any()) {
-    const bool keep = options.at_max_depth == DepthLimit::Keep &&
-                      patch.longestEdge() <= kMaxUnsplitEdge * splitThreshold(grid, options);
-    result.fate = patch.depth < options.max_depth ? PatchFate::Split : keep ? PatchFate::Keep : PatchFate::KilledDepth;
+  } else if ((result.split = splitAxes(patch, threshold, options.split_rule)).any()) {
+    // With sharp interfaces a patch whose corners are in different materials (part way through an
+    // interface) is not split: its new corners would mix the two sides' rays.
+    const bool splittable = !sharp || (oneMedium(patch) && crossing.blocked == 0);
+    const bool keep = options.at_max_depth == DepthLimit::Keep && patch.longestEdge() <= kMaxUnsplitEdge * threshold;
+    result.fate = splittable && patch.depth < options.max_depth ? PatchFate::Split
+                  : keep                                        ? PatchFate::Keep
+                                                                : PatchFate::KilledDepth;
   } else {
     result.fate = PatchFate::Keep;
   }
@@ -222,6 +396,73 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   return run(light, options, nullptr);
 }
 
+namespace {
+
+// The track deposits of one step (track_deposit.h), applied by slabs of z-slices in parallel: a
+// voxel belongs to one slab, whose thread adds the sub-paths in patch order, so the sums do not
+// depend on the thread count.
+void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<PatchStepResult>& results,
+                        const GridSpec& grid, const ReceiverMap* receiver, std::vector<glm::dvec3>& irradiance,
+                        std::vector<glm::dvec3>& direction) {
+  const std::size_t count = results.size();
+  const glm::dvec3 h = grid.voxelSize();
+  const double inv_volume = 1.0 / grid.voxelVolume();
+  // Slabs of z-slices, and the patches whose hats reach each one (in patch order).
+  const int slab_depth = std::max(1, grid.dims.z / (4 * static_cast<int>(workerThreads())));
+  const int slabs = (grid.dims.z + slab_depth - 1) / slab_depth;
+  std::vector<std::vector<std::uint32_t>> by_slab(static_cast<std::size_t>(slabs));
+  for (std::size_t i = 0; i < count; ++i) {
+    const PatchStepResult& r = results[i];
+    if (!r.track || r.rolled_back) continue;
+    double zlo = std::numeric_limits<double>::infinity(), zhi = -zlo;
+    for (int c = 0; c < 4; ++c) {
+      zlo = std::min(zlo, std::min(r.from[c].z, patches[i].x[c].z));
+      zhi = std::max(zhi, std::max(r.from[c].z, patches[i].x[c].z));
+    }
+    // Hats reach one voxel centre beyond the path: slices whose centre is within h of [zlo, zhi].
+    const int k0 = std::max(0, static_cast<int>(std::floor((zlo - grid.bounds_min.z) / h.z - 1.5)));
+    const int k1 = std::min(grid.dims.z - 1, static_cast<int>(std::floor((zhi - grid.bounds_min.z) / h.z + 0.5)));
+    for (int slab = k0 / slab_depth; slab <= k1 / slab_depth && slab < slabs; ++slab)
+      by_slab[static_cast<std::size_t>(slab)].push_back(static_cast<std::uint32_t>(i));
+  }
+  const std::size_t slice = static_cast<std::size_t>(grid.dims.x) * static_cast<std::size_t>(grid.dims.y);
+  parallelFor(0, slabs, [&](std::int64_t slab64) {
+    const std::size_t lo = static_cast<std::size_t>(slab64) * static_cast<std::size_t>(slab_depth) * slice;
+    const std::size_t hi = std::min(grid.count(), lo + static_cast<std::size_t>(slab_depth) * slice);
+    for (const std::uint32_t i : by_slab[static_cast<std::size_t>(slab64)]) {
+      const PatchStepResult& r = results[i];
+      const Patch& p = patches[i];
+      const glm::dvec3 flux = r.track_flux / static_cast<double>(r.lattice.x * r.lattice.y);
+      const double lum = luminance(flux);
+      for (int iv = 0; iv < r.lattice.y; ++iv)
+        for (int iu = 0; iu < r.lattice.x; ++iu) {
+          const double u = (iu + 0.5) / r.lattice.x, v = (iv + 0.5) / r.lattice.y;
+          const glm::dvec3 a = bilinear(r.from, u, v);
+          glm::dvec3 b = bilinear(p.x, u, v);
+          if (r.clip_to_receiver && receiver) {
+            const double ha = glm::dot(a - receiver->point, receiver->normal);
+            const double hb = glm::dot(b - receiver->point, receiver->normal);
+            if (ha <= 0.0) continue;  // this sub-path is already under the plane
+            if (hb < 0.0) b = a + (ha / (ha - hb)) * (b - a);
+          }
+          const double length = glm::length(b - a);
+          if (!(length > 0.0)) continue;
+          const glm::dvec3 dir = (b - a) / length;
+          const glm::dvec3 e = flux * (length * inv_volume);
+          const glm::dvec3 dsum = (lum * length) * dir;
+          forEachTrackWeight(grid.toVoxel(a), grid.toVoxel(b), grid.dims, [&](long long v, double w) {
+            const std::size_t at = static_cast<std::size_t>(v);
+            if (at < lo || at >= hi) return;
+            irradiance[at] += e * w;
+            direction[at] += dsum * w;
+          });
+        }
+    }
+  });
+}
+
+}  // namespace
+
 BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& options, CpuRunDiagnostics* diagnostics) {
   if (diagnostics) *diagnostics = CpuRunDiagnostics{};
   const GridSpec& grid = sampler_.grid();
@@ -233,20 +474,27 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   stats.renderer = "cpu, " + std::to_string(threads) + (threads == 1 ? " thread" : " threads");
 
   Stopwatch phase;
+  validateLight(light);
+  validateOptions(options);
+  StepContext ctx = makeStepContext(sampler_, options, 0.0);
+  // The receiver's map (its geometry first: the initial patches cover it).
+  ReceiverMap receiver;
+  std::vector<glm::dvec3> receiver_flux;
+  if (options.receiver) {
+    receiver = receiverGeometry(*options.receiver, light, grid, ctx.box_lo, ctx.box_hi);
+    receiver_flux.assign(receiver.texelCount(), glm::dvec3(0.0));
+    ctx.receiver = &receiver;
+  }
   double flux_ref = 0.0;
-  std::vector<Patch> patches = initialPatches(light, grid, sampler_, options, &flux_ref);
+  std::vector<Patch> patches = initialPatches(light, grid, sampler_, options, &flux_ref, ctx.receiver);
+  ctx.flux_ref = flux_ref;
   stats.initial_patches = patches.size();
   for (const Patch& p : patches) stats.flux_in += p.flux;
   stats.phase_seconds["init"] = phase.seconds();
 
-  StepContext ctx;
-  ctx.sampler = &sampler_;
-  ctx.options = &options;
-  ctx.dt = timeStep(grid, options);
-  ctx.flux_ref = flux_ref;
-  ctx.voxel_volume = grid.voxelVolume();
   const int max_steps = maxSteps(grid, options);
   const bool accumulate = options.deposit == DepositMode::Accumulate;
+  const bool track = accumulate && options.deposit_kernel == DepositKernel::Track;
 
   // Deposit targets, in double (accumulate) or the strongest patch so far (max).
   std::vector<glm::dvec3> irradiance(patches.empty() ? 0 : voxels, glm::dvec3(0.0));
@@ -283,8 +531,9 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
         256);
     t_update += t.seconds();
 
-    // Deposit and the ledger, sequentially in patch order (deterministic sums).
+    // Deposits and the ledger, in patch order (deterministic sums).
     t.restart();
+    if (track) applyTrackDeposits(patches, results, grid, ctx.receiver, irradiance, direction);
     offsets.resize(count + 1);
     std::uint64_t total = 0;
     for (std::size_t i = 0; i < count; ++i) {
@@ -292,6 +541,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
       const Patch& p = patches[i];
       stats.flux_absorbed += r.absorbed;
       stats.flux_reflected += r.reflected;
+      if (r.rolled_back) ++stats.rollbacks;
       if (r.voxel >= 0) {
         const std::size_t v = static_cast<std::size_t>(r.voxel);
         if (accumulate) {
@@ -327,13 +577,28 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
           ++stats.kills.depth;
           stats.flux_killed += p.flux;
           break;
+        case PatchFate::Received:
+          ++stats.kills.received;
+          stats.flux_received += r.received;
+          depositFootprint(receiver, r.footprint, r.received, receiver_flux);
+          break;
+        case PatchFate::Blocked:
+          ++stats.kills.blocked;
+          stats.flux_blocked += p.flux;
+          break;
+      }
+      if (r.spawn_reflection) {
+        // The reflected wavefront is followed: its flux is no longer lost to reflection.
+        total += 1;
+        ++stats.reflections;
+        stats.flux_reflected -= r.reflection.flux;
       }
     }
     offsets[count] = total;
     t_deposit += t.seconds();
 
     // Step 6: compaction and expansion by the prefix sum, in index order (the histogram pyramid's
-    // order: output slot k of source s with sub-index j = child j of the split).
+    // order: output slot k of source s with sub-index j = child j of the split; a reflection last).
     t.restart();
     next.resize(total);
     next_samples.resize(total);
@@ -341,20 +606,28 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
         0, static_cast<std::int64_t>(count),
         [&](std::int64_t i64) {
           const std::size_t i = static_cast<std::size_t>(i64);
-          const std::size_t out = offsets[i];
-          const std::size_t n_out = offsets[i + 1] - out;
+          const PatchStepResult& r = results[i];
+          std::size_t out = offsets[i];
+          const std::size_t n_out = offsets[i + 1] - out - (r.spawn_reflection ? 1 : 0);
           if (n_out == 1) {
             next[out] = patches[i];
             next_samples[out] = samples[i];
           } else if (n_out > 1) {
             std::array<std::array<glm::dvec4, 4>, 4> corner_samples;
             std::array<Patch, 4> children;
-            const int count = splitPatch(patches[i], sampler_, results[i].split, children, &corner_samples);
-            for (int j = 0; j < count; ++j) {
+            const int made = splitPatch(patches[i], sampler_, r.split, children, &corner_samples);
+            for (int j = 0; j < made; ++j) {
               next[out + j] = children[j];
               next_samples[out + j].corner = corner_samples[j];
               next_samples[out + j].n_mid = sampler_.ior(children[j].midpoint());
             }
+          }
+          if (r.spawn_reflection) {
+            out += n_out;
+            next[out] = r.reflection;
+            next_samples[out] = samplePatch(r.reflection, sampler_);
+            for (int c = 0; c < 4; ++c)
+              next_samples[out].corner[c] = sampler_.materialOptics(r.reflection.medium[c], r.reflection.x[c]);
           }
         },
         256);
@@ -363,8 +636,9 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
     t_compact += t.seconds();
 
     if (options.progress && total_in > 0.0) {
-      const double retired =
-          luminance(stats.flux_out + stats.flux_absorbed + stats.flux_reflected + stats.flux_killed) / total_in;
+      const double retired = luminance(stats.flux_out + stats.flux_absorbed + stats.flux_reflected + stats.flux_killed +
+                                       stats.flux_received + stats.flux_blocked) /
+                             total_in;
       options.progress(std::min(1.0, retired));
     }
   }
@@ -389,6 +663,14 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
             for (int c = 0; c < 3; ++c) d[c] = static_cast<float>(direction[v][c] / len);
         },
         4096);
+  }
+  if (options.receiver) {
+    // Planar irradiance: each texel's flux over its area.
+    const double inv_area = 1.0 / (receiver.pitch * receiver.pitch);
+    receiver.irradiance.resize(receiver.texelCount() * 3);
+    for (std::size_t t = 0; t < receiver.texelCount(); ++t)
+      for (int c = 0; c < 3; ++c) receiver.irradiance[3 * t + static_cast<std::size_t>(c)] = static_cast<float>(receiver_flux[t][c] * inv_area);
+    bake.receivers.push_back(std::move(receiver));
   }
   stats.phase_seconds["update"] = t_update;
   stats.phase_seconds["deposit"] = t_deposit;

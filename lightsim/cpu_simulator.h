@@ -49,17 +49,33 @@ class CpuSimulator : public Simulator {
 
 // One step of one patch in place: ALGORITHM.md steps 1–5 (update, absorption, Fresnel, deposit
 // record, analysis). Exposed so that tests and the GPU path can check single steps.
-enum class PatchFate { Keep, Split, KilledFlux, Exited, Folded, KilledDepth };
+enum class PatchFate { Keep, Split, KilledFlux, Exited, Folded, KilledDepth, Received, Blocked };
 
 struct PatchStepResult {
   PatchFate fate = PatchFate::Keep;
   SplitAxes split;                 // the axes a Split halves
+  // Point kernel and `max` mode: one deposit at the voxel of the new midpoint.
   long long voxel = -1;            // voxel the deposit goes to (−1: the midpoint is outside the grid)
   glm::dvec3 deposit{0.0};         // accumulate: Φ·Δs_m/V_voxel; max: E = Φ/A
   glm::dvec3 deposit_dir{0.0};     // accumulate: lum(Φ)·Δs_m·d; max: d
   double max_key = 0.0;            // max: lum(E)
+  // Track kernel (track_deposit.h): the sub-paths from the old corners to the new ones, each
+  // carrying track_flux/(lattice.x·lattice.y), clipped at the receiver plane when the patch reached it.
+  bool track = false;
+  std::array<glm::dvec3, 4> from{};
+  glm::dvec3 track_flux{0.0};
+  glm::ivec2 lattice{1, 1};
+  bool clip_to_receiver = false;
   glm::dvec3 absorbed{0.0};        // Φ·(1 − exp(−σa·Δs_m))
-  glm::dvec3 reflected{0.0};       // R·Φ on leaving a boundary layer
+  glm::dvec3 reflected{0.0};       // R·Φ at a boundary layer or a sharp interface, not followed
+  // Received: the footprint on the receiver plane ((u, v) coordinates) and the flux it carries.
+  std::array<glm::dvec2, 4> footprint{};
+  glm::dvec3 received{0.0};
+  // Sharp interfaces: the step was undone so that the patch splits before it crosses
+  // (ALGORITHM.md "Sharp interfaces"), and the reflected wavefront to follow (bounces).
+  bool rolled_back = false;
+  bool spawn_reflection = false;
+  Patch reflection;
 };
 
 struct StepContext {
@@ -68,7 +84,12 @@ struct StepContext {
   double dt = 0.0;           // Δt
   double flux_ref = 0.0;     // Φ_ref
   double voxel_volume = 0.0;
+  glm::dvec3 box_lo{0.0}, box_hi{0.0};  // propagationBox
+  const ReceiverMap* receiver = nullptr; // the receiver's geometry (no data), or none
 };
+
+// The constants of a run: Δt, the voxel volume, the propagation box (no receiver).
+StepContext makeStepContext(const VolumeSampler& sampler, const SimulationOptions& options, double flux_ref);
 
 PatchStepResult stepPatch(Patch& patch, const StepContext& context);
 

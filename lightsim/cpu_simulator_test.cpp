@@ -63,7 +63,7 @@ TEST(CpuSimulator, PlaneWaveDepositsItsIrradiance) {
   CpuSimulator sim(uniformVolume(g, 1.0));
   LightSpec light;
   light.power = {2.0, 1.0, 0.5};
-  const BakeResult r = sim.run(light, {});
+  const BakeResult r = sim.run(light, test_scenes::pointDepositOptions());
   // Step 0.5 voxel: two deposits of Φ·Δs/V per voxel, E = E_L exactly.
   for (int j = 0; j < 24; ++j) {
     EXPECT_NEAR(voxelValue(r.irradiance, g, 5, j, 17).x, 2.0, 1e-5) << j;
@@ -172,7 +172,7 @@ TEST(CpuSimulator, EnergyLedgerClosesAndThePlaneBelowTheSphereGetsWhatRayTracing
   const Volume v = glassSphere(40, box({-0.8, -0.7, -0.8}, {0.8, 0.6, 0.8}), R, 1.5);
   CpuSimulator sim(v);
   const LightSpec light;
-  const SimulationOptions options;
+  const SimulationOptions options = test_scenes::pointDepositOptions();
   CpuRunDiagnostics diag;
   const BakeResult r = sim.run(light, options, &diag);
   const SimulationStats& s = r.stats;
@@ -259,7 +259,7 @@ TEST(CpuSimulator, GlassSlabTransmitsTwoFresnelFactors) {
   const Bounds b = box({-0.25, -0.5, -0.25}, {0.25, 0.5, 0.25});
   const Volume v = slab(32, b, -0.15, 0.3, 1.5, glm::dvec3(0.0));
   CpuSimulator sim(v);
-  const BakeResult r = sim.run(LightSpec{}, {});
+  const BakeResult r = sim.run(LightSpec{}, test_scenes::pointDepositOptions());
   const double in = r.stats.flux_in.x, R = 0.04;
   const int j = layerOf(v.grid, -0.35);
   const double below = downwardFlux(r.irradiance, r.light_dir, v.grid, j - 4, j).x;
@@ -280,7 +280,7 @@ TEST(CpuSimulator, AbsorbingSlabFollowsBeerLambert) {
   const double d = 0.4;
   const Volume v = slab(32, b, -0.2, d, 1.0, sigma);
   CpuSimulator sim(v);
-  const BakeResult r = sim.run(LightSpec{}, {});
+  const BakeResult r = sim.run(LightSpec{}, test_scenes::pointDepositOptions());
   const glm::dvec3 in = r.stats.flux_in;
   const int j = layerOf(v.grid, -0.3);
   const glm::dvec3 below = downwardFlux(r.irradiance, r.light_dir, v.grid, j - 4, j);

@@ -177,6 +177,9 @@ GpuSimulator::GpuSimulator(const Volume& volume, GpuSimulatorOptions options)
 
 GpuSimulator::GpuSimulator(const Volume& volume, GpuSimulatorOptions options, std::unique_ptr<gl::GlContext> context)
     : ownedContext_(std::move(context)) {
+  if (volume.has("interfaces"))
+    throw InputError(options.source, "fields.interfaces",
+                     "the GPU path does not do sharp interfaces yet: bake with the CPU twin (--backend cpu or auto)");
   if (ownedContext_ && gl::GlContext::current() != ownedContext_.get()) ownedContext_->makeCurrent();
   if (!ownedContext_ && !gl::GlContext::current()) {  // none given, none current: a headless one
     gl::ContextOptions co;
@@ -192,6 +195,10 @@ GpuSimulator::~GpuSimulator() {
 }
 
 BakeResult GpuSimulator::run(const LightSpec& light, const SimulationOptions& options) {
+  if (options.deposit == DepositMode::Accumulate && options.deposit_kernel == DepositKernel::Track)
+    throw InputError("lightsim options", "deposit_kernel",
+                     "the GPU path deposits at patch midpoints only (DepositKernel::Point) so far");
+  if (options.receiver) throw InputError("lightsim options", "receiver", "the GPU path makes no receiver maps yet");
   if (ownedContext_ && gl::GlContext::current() != ownedContext_.get()) ownedContext_->makeCurrent();
   return impl_->run(light, options);
 }

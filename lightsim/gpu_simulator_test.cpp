@@ -279,7 +279,7 @@ TEST_P(AbsorbingSlab, FollowsBeerLambert) {
   LightSpec light;
   light.direction = glm::dvec3(0, 0, 1);
   light.power = glm::dvec3(EL);
-  SimulationOptions options;
+  SimulationOptions options = test_scenes::pointDepositOptions();
   options.step_voxels = 1.0 / 3.0;
   const BakeResult r = gpu.run(light, options);
   const GridSpec& g = volume.grid;
@@ -381,13 +381,13 @@ TEST(GpuSimulatorTest, LightThatMissesTheVolumeGivesAnEmptyBake) {
   LightSpec light;
   light.type = LightSpec::Type::Point;
   light.position = glm::dvec3(100.0, 37.0, -55.0);
-  const BakeResult r = gpu.run(light, SimulationOptions{});
+  const BakeResult r = gpu.run(light, test_scenes::pointDepositOptions());
   EXPECT_EQ(r.stats.initial_patches, 0u);
   EXPECT_EQ(r.stats.steps, 0);
   EXPECT_EQ(r.irradiance.data, std::vector<float>(volume.grid.count() * 3, 0.0f));
   EXPECT_EQ(r.light_dir.data, std::vector<float>(volume.grid.count() * 3, 0.0f));
   // And a light with no power: patches, but nothing deposited and nothing broken.
-  const BakeResult dark = gpu.run(LightSpec{.power = glm::dvec3(0.0)}, SimulationOptions{});
+  const BakeResult dark = gpu.run(LightSpec{.power = glm::dvec3(0.0)}, test_scenes::pointDepositOptions());
   EXPECT_GT(dark.stats.initial_patches, 0u);
   EXPECT_EQ(dark.irradiance.data, std::vector<float>(volume.grid.count() * 3, 0.0f));
 }
@@ -412,7 +412,7 @@ TEST(GpuBench, DISABLED_GlassSphere) {
     GpuSimulatorOptions o;
     o.timing = timing;
     GpuSimulator gpu(volume, o);
-    const BakeResult r = gpu.run(light, SimulationOptions{});
+    const BakeResult r = gpu.run(light, test_scenes::pointDepositOptions());
     const GpuRunInfo& info = gpu.lastRunInfo();
     const SimulationStats& s = r.stats;
     std::printf("timing %d: wall %.2f s, %d steps, %llu patch-steps (%.2f M/s), peak %llu patches (list side %d), "
@@ -426,7 +426,7 @@ TEST(GpuBench, DISABLED_GlassSphere) {
   if (std::getenv("BENCH_CPU")) {
     const Stopwatch t;
     CpuSimulator cpu(volume);
-    const BakeResult r = cpu.run(light, SimulationOptions{});
+    const BakeResult r = cpu.run(light, test_scenes::pointDepositOptions());
     std::printf("cpu twin: %.2f s, %llu patch-steps\n", t.seconds(), (unsigned long long)r.stats.total_patches);
   }
 }

@@ -22,6 +22,7 @@
 #include "core/volume.h"
 #include "lightsim/bake.h"
 #include "lightsim/make_simulator.h"
+#include "lightsim/wavefront.h"
 
 namespace fs = std::filesystem;
 
@@ -29,10 +30,12 @@ namespace eik {
 namespace {
 
 int run(int argc, char** argv) {
-  std::string input, output, light_text, power_text = "1,1,1", scene_path, backend = "gl", deposit = "accumulate",
+  std::string input, output, light_text, power_text = "1,1,1", scene_path, backend = "auto", deposit = "accumulate",
                                          integrator = "euler", split_rule = "axis", at_max_depth = "keep", stats_path,
-                                         gl_backend = "auto";
+                                         gl_backend = "auto", kernel = "track", receiver_text;
+  bool no_receiver = false;
   SimulationOptions options;
+  double options_receiver_pitch = 0.25;
   int bench_runs = 0;
   double smooth_irradiance = 0.0;
   bool quiet = false, raw = false;
@@ -47,10 +50,28 @@ int run(int argc, char** argv) {
   app.add_option("--power", power_text,
                  "R,G,B: irradiance in W/m² of a directional light, radiant intensity in W/sr of a point light "
                  "(default 1,1,1)");
-  app.add_option("--scene", scene_path, "take the light from this SCENE.json (its first light) instead of --light");
+  app.add_option("--scene", scene_path,
+                 "take the light from this SCENE.json (its first light) instead of --light, and its ground as the "
+                 "receiver");
+  app.add_option("--receiver", receiver_text,
+                 "PX,PY,PZ:NX,NY,NZ[:HALF_EXTENT]: a receiver plane through P facing N (the light's side) that "
+                 "stops the light and gets its own map of planar irradiance (default: the --scene's ground)");
+  app.add_flag("--no-receiver", no_receiver, "no receiver map, even when the --scene has a ground");
+  app.add_option("--receiver-pitch", options_receiver_pitch,
+                 "texel edge of the receiver map in voxels of the volume (default 0.25)")
+      ->check(CLI::Range(0.01, 8.0));
+  app.add_option("--bounces", options.bounces,
+                 "Fresnel reflections at sharp interfaces followed as wavefronts of their own (default 1; 0: their "
+                 "flux is counted as reflected)")
+      ->check(CLI::Range(0, 8));
+  app.add_option("--deposit-kernel", kernel,
+                 "track (default: flux times path length over the patch's footprint, with each voxel's trilinear "
+                 "hat: flat in free air) or point (the first release: all of it at the voxel of the patch's "
+                 "midpoint; the only kernel of the GPU path so far)")
+      ->check(CLI::IsMember({"track", "point"}));
   app.add_option("--backend", backend,
-                 "gl (the GPU particle system, default), cpu (the CPU twin) or auto (gl on a hardware GPU, cpu "
-                 "when OpenGL is a software rasterizer such as llvmpipe, where the twin is faster)")
+                 "auto (default: gl on a hardware GPU for what the GPU path does, cpu otherwise), gl (the GPU "
+                 "particle system) or cpu (the CPU twin, multi-threaded)")
       ->check(CLI::IsMember({"gl", "cpu", "auto"}));
   app.add_option("--deposit", deposit,
                  "accumulate (default: sums every wavefront sheet, conserves energy) or max (the thesis: the "
@@ -67,7 +88,11 @@ int run(int argc, char** argv) {
                  "axis (default: halve only the directions whose edges are too long, 1x2 or 2x2) or quad "
                  "(the thesis: always 2x2)")
       ->check(CLI::IsMember({"axis", "quad"}));
-  app.add_option("--max-depth", options.max_depth, "splits allowed per initial patch, a 1x2 split counting 1/2 (default 6)")->check(CLI::Range(0, 16));
+  CLI::Option* max_depth =
+      app.add_option("--max-depth", options.max_depth,
+                     "splits allowed per initial patch, a 1x2 split counting 1/2 (default 4 for a volume with sharp "
+                     "interfaces, 6 for a smoothed one)")
+          ->check(CLI::Range(0, 16));
   app.add_option("--at-max-depth", at_max_depth,
                  "keep (default: a patch that should split beyond --max-depth goes on unsplit while its edges stay "
                  "within 4 split lengths, then dies) or kill (the thesis: it dies at once)")
@@ -92,6 +117,7 @@ int run(int argc, char** argv) {
       "Examples:\n"
       "  lightsim sphere.vol.json -o sphere.baked.vol.json --light directional:0,-1,0 --power 1,1,1\n"
       "  lightsim glass.vol.json -o glass.baked.vol.json --scene glass.scene.json --backend cpu\n"
+      "  lightsim sphere.vol.json -o sphere.baked.vol.json --light directional:0,-1,0 --receiver 0,0,0:0,1,0\n"
       "Exit codes: 0 success, 1 runtime failure, 2 bad usage or bad input.");
   if (!parseCommandLine(app, argc, argv)) return kExitOk;
 
@@ -109,10 +135,20 @@ int run(int argc, char** argv) {
   options.split_rule = split_rule == "quad" ? SplitRule::Quad : SplitRule::Axis;
   options.at_max_depth = at_max_depth == "kill" ? DepthLimit::Kill : DepthLimit::Keep;
   options.integrator = integrator == "rk4" ? Integrator::RK4 : integrator == "rk2" ? Integrator::RK2 : Integrator::Euler;
+  options.deposit_kernel = kernel == "point" ? DepositKernel::Point : DepositKernel::Track;
+  if (!receiver_text.empty() && no_receiver)
+    throw InputError("command line", "--no-receiver", "give --receiver or --no-receiver, not both");
+  if (!receiver_text.empty()) {
+    options.receiver = parseReceiver(receiver_text);
+  } else if (!scene_path.empty() && !no_receiver) {
+    options.receiver = receiverFromScene(scene_path);
+  }
+  if (options.receiver) options.receiver->pitch_voxels = options_receiver_pitch;
 
   Volume volume = readVolume(input);
   volume.require("ior", 1, input);
   volume.require("ior_grad", 3, input);
+  if (max_depth->count() == 0) options.max_depth = volume.has("interfaces") ? 4 : 6;
 
   SimulatorBackendOptions choice;
   choice.backend = backend == "cpu"    ? SimulatorBackend::Cpu
@@ -122,7 +158,7 @@ int run(int argc, char** argv) {
   choice.source = input;
   if (!quiet)
     choice.report = [](const std::string& why) { std::fprintf(stderr, "lightsim: --backend auto: %s\n", why.c_str()); };
-  const std::unique_ptr<Simulator> simulator = makeSimulator(volume, choice);
+  const std::unique_ptr<Simulator> simulator = makeSimulator(volume, choice, &options);
   ProgressBar bar("lightsim", !quiet && bench_runs == 0);
   options.progress = bar.callback();
   BakeResult result;
@@ -171,6 +207,10 @@ int run(int argc, char** argv) {
     std::fprintf(stderr, "lightsim: %d steps, %llu initial / %llu peak patches, %llu splits on %s\n", s.steps,
                  static_cast<unsigned long long>(s.initial_patches), static_cast<unsigned long long>(s.peak_patches),
                  static_cast<unsigned long long>(s.splits), s.renderer.c_str());
+    for (const ReceiverMap& map : result.receivers)
+      std::fprintf(stderr, "lightsim: receiver '%s': %d x %d texels of %.4g, %.4g W of %.4g W received\n",
+                   map.name.c_str(), map.texels.x, map.texels.y, map.pitch, luminance(s.flux_received),
+                   luminance(s.flux_in));
     std::fprintf(stderr, "lightsim: wrote %s\n", output.c_str());
   }
   return kExitOk;

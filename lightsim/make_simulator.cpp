@@ -3,14 +3,34 @@
 
 #include <exception>
 
+#include "core/error.h"
+
 #include "gl/context.h"
 #include "lightsim/cpu_simulator.h"
 #include "lightsim/gpu_simulator.h"
 
 namespace eik {
 
-std::unique_ptr<Simulator> makeSimulator(const Volume& volume, const SimulatorBackendOptions& options) {
+std::string gpuPathLacks(const Volume& volume, const SimulationOptions& simulation) {
+  if (volume.has("interfaces")) return "sharp interfaces (the volume has an interfaces field)";
+  if (simulation.deposit == DepositMode::Accumulate && simulation.deposit_kernel == DepositKernel::Track)
+    return "track deposits (--deposit-kernel track)";
+  if (simulation.receiver) return "receiver maps";
+  return "";
+}
+
+std::unique_ptr<Simulator> makeSimulator(const Volume& volume, const SimulatorBackendOptions& options,
+                                         const SimulationOptions* simulation) {
   SimulatorBackend backend = options.backend;
+  const std::string lacks = simulation ? gpuPathLacks(volume, *simulation) : std::string();
+  if (!lacks.empty()) {
+    if (backend == SimulatorBackend::Gl)
+      throw InputError("--backend", "gl", "the GPU path does not do " + lacks + " yet: use --backend cpu or auto");
+    if (backend == SimulatorBackend::Auto) {
+      if (options.report) options.report("the GPU path does not do " + lacks + " yet, so the CPU twin");
+      return std::make_unique<CpuSimulator>(volume);
+    }
+  }
   // Auto: probe the OpenGL renderer; a hardware context stays alive for the GPU path.
   std::unique_ptr<gl::GlContext> probe;
   if (backend == SimulatorBackend::Auto) {

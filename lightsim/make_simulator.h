@@ -31,8 +31,14 @@ struct SimulatorBackendOptions {
   std::function<void(const std::string&)> report;
 };
 
+// What the GPU path cannot do yet (ALGORITHM.md "Back ends"): sharp interfaces, track deposits,
+// receiver maps. Returns "" when it can bake `volume` with `simulation`, else the reason.
+std::string gpuPathLacks(const Volume& volume, const SimulationOptions& simulation);
+
 // The simulator for `volume` (see GpuSimulator's and CpuSimulator's constructors for what they
-// read and throw).
-std::unique_ptr<Simulator> makeSimulator(const Volume& volume, const SimulatorBackendOptions& options);
+// read and throw). With `simulation` given, Auto takes the CPU twin for a bake the GPU path cannot
+// do yet (gpuPathLacks), and Gl refuses it with an InputError naming --backend.
+std::unique_ptr<Simulator> makeSimulator(const Volume& volume, const SimulatorBackendOptions& options,
+                                         const SimulationOptions* simulation = nullptr);
 
 }  // namespace eik

@@ -7,12 +7,14 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
 #include "core/progress.h"
+#include "core/receiver_map.h"
 #include "core/volume.h"
 
 namespace eik {
@@ -35,14 +37,38 @@ enum class SplitRule { Quad, Axis };
 // What becomes of a patch that should split beyond max_depth (ALGORITHM.md step 5).
 enum class DepthLimit { Keep, Kill };
 
+// How an `accumulate` deposit is spread (ALGORITHM.md step 4):
+//  - Track: the flux times the path length of each sub-path of the patch (lattice ≤ ½ voxel), with
+//    the trilinear hat of each voxel, exactly along the path (lightsim/track_deposit.h): flux-exact,
+//    flat in free air at any angle. The CPU twin's default.
+//  - Point: all of Φ·Δs/V at the voxel of the patch's midpoint (the first release; the GPU path).
+enum class DepositKernel { Track, Point };
+
+// A receiver plane (lightsim/receiver.h): the ground, with its own map of planar irradiance.
+struct ReceiverSpec {
+  std::string name = "ground";
+  glm::dvec3 point{0.0};
+  glm::dvec3 normal{0.0, 1.0, 0.0};  // unit, facing the light
+  double half_extent = 1e30;         // the plane is the square of this half side around `point`
+  double pitch_voxels = 0.25;        // texel edge in voxels of the volume
+};
+
 struct SimulationOptions {
   DepositMode deposit = DepositMode::Accumulate;
+  DepositKernel deposit_kernel = DepositKernel::Track;
+  std::optional<ReceiverSpec> receiver;  // the plane that stops the light and gets a map
+  // Fresnel reflections at sharp interfaces followed as their own wavefronts (0: none; their flux
+  // is counted as reflected).
+  int bounces = 1;
   Integrator integrator = Integrator::Euler;
   double step_voxels = 0.5;       // Δt = step_voxels·h: the arc length per step in air, in voxels
   double patch_voxels = 1.0;      // initial patch edge, at most this many voxels
   double split_voxels = 1.0;      // split a patch whose longest edge exceeds this many voxels
   SplitRule split_rule = SplitRule::Axis;  // Axis: halve only the long direction (1×2); Quad: 2×2 (thesis)
-  int max_depth = 6;              // splits allowed per initial patch (a 1×2 split counts ½)
+  // Splits allowed per initial patch (a 1×2 split counts ½). `lightsim` takes 4 for a volume with
+  // sharp interfaces (measured on the glass sphere: more accurate on the ground and 5–7× faster
+  // than 6, whose extra slivers only tear at the silhouette) and 6 for a smoothed one.
+  int max_depth = 6;
   // At max_depth a patch that should split is kept unsplit (Keep, default: its flux goes on and is
   // deposited at its midpoint) or killed (Kill, the thesis §6.2.4; its flux is lost).
   DepthLimit at_max_depth = DepthLimit::Keep;
@@ -58,6 +84,8 @@ struct KillCounts {
   std::uint64_t exited = 0;   // left the volume, heading away
   std::uint64_t folded = 0;   // orientation flipped (caustic singularity)
   std::uint64_t depth = 0;    // needed a split beyond max_depth (DepthLimit::Kill only)
+  std::uint64_t received = 0; // reached the receiver plane
+  std::uint64_t blocked = 0;  // stopped by an opaque material
 };
 
 struct SimulationStats {
@@ -67,13 +95,18 @@ struct SimulationStats {
   std::uint64_t total_patches = 0;   // Σ over steps of live patches (patch-steps)
   std::uint64_t splits = 0;
   KillCounts kills;
-  // Fluxes in W, RGB. flux_in = out + absorbed + reflected + killed + unfinished.
+  // Fluxes in W, RGB. flux_in = out + absorbed + reflected + killed + unfinished + received +
+  // blocked; `reflected` is what Fresnel reflection took and no followed wavefront carries.
   glm::dvec3 flux_in{0.0};
   glm::dvec3 flux_out{0.0};          // carried out of the volume by exiting patches
   glm::dvec3 flux_absorbed{0.0};
   glm::dvec3 flux_reflected{0.0};    // Fresnel reflection at boundaries
   glm::dvec3 flux_killed{0.0};       // flux, folded and depth kills
   glm::dvec3 flux_unfinished{0.0};   // still alive at max_steps
+  glm::dvec3 flux_received{0.0};     // absorbed by the receiver plane (its map)
+  glm::dvec3 flux_blocked{0.0};      // stopped by opaque materials
+  std::uint64_t reflections = 0;     // reflected wavefronts followed (bounces)
+  std::uint64_t rollbacks = 0;       // steps undone to split a patch torn by an interface
   std::map<std::string, double> phase_seconds;   // "init", "update", "analysis", "compact", "deposit", "readback", ...
   std::string backend;               // "gl" or "cpu"
   std::string renderer;              // GL renderer string or "cpu, N threads"
@@ -84,6 +117,7 @@ struct SimulationStats {
 struct BakeResult {
   Field irradiance;   // 3 components, W/m²
   Field light_dir;    // 3 components, unit (0 where no light passed)
+  std::vector<ReceiverMap> receivers;  // the receiver's map, when one was given
   SimulationStats stats;
 };
 

@@ -105,6 +105,12 @@ VolumeSampler::VolumeSampler(const Volume& volume) : grid_(volume.grid), h_(voxe
     const float* g = grad.voxel(i);
     ior_grad_[i] = glm::vec4(ior.data[i], g[0], g[1], g[2]);
   }
+  table_ = interfaceTable(volume);
+  if (!table_.empty()) {
+    const Field& d = volume.require("interfaces", 4);
+    distances_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) distances_[i] = glm::vec4(d.voxel(i)[0], d.voxel(i)[1], d.voxel(i)[2], d.voxel(i)[3]);
+  }
   if (const Field* sa = volume.find("sigma_a")) {
     if (sa->components != 3) throw InputError("volume", "sigma_a", "expected 3 components");
     bool any = false;
@@ -119,7 +125,33 @@ VolumeSampler::VolumeSampler(const Volume& volume) : grid_(volume.grid), h_(voxe
 double VolumeSampler::ior(const glm::dvec3& world) const { return iorAndGradient(world).x; }
 
 glm::dvec4 VolumeSampler::iorAndGradient(const glm::dvec3& world) const {
+  if (sharp()) return materialOptics(materialAt(world), world);
   return interpolate<glm::dvec4>(ior_grad_, grid_, taps3(grid_, world, grid_.extent()));
+}
+
+glm::dvec4 VolumeSampler::distances(const glm::dvec3& world) const {
+  if (distances_.empty()) return glm::dvec4(0.0);
+  return interpolate<glm::dvec4>(distances_, grid_, taps3(grid_, world, grid_.extent()));
+}
+
+glm::dvec4 VolumeSampler::materialOptics(int slot, const glm::dvec3& world) const {
+  if (!sharp()) return iorAndGradient(world);
+  if (slot < 0) return {1.0, 0.0, 0.0, 0.0};
+  const InterfaceSlot& s = table_.slots[static_cast<std::size_t>(slot)];
+  if (!s.graded) return {s.ior, 0.0, 0.0, 0.0};
+  return interpolate<glm::dvec4>(ior_grad_, grid_, taps3(grid_, world, grid_.extent()));
+}
+
+glm::dvec3 VolumeSampler::interfaceNormal(int slot, const glm::dvec3& world) const {
+  const glm::dvec3 h = 0.5 * grid_.voxelSize();
+  glm::dvec3 g;
+  for (int a = 0; a < 3; ++a) {
+    glm::dvec3 e(0.0);
+    e[a] = h[a];
+    g[a] = (distances(world + e)[slot] - distances(world - e)[slot]) / (2.0 * h[a]);
+  }
+  const double len = glm::length(g);
+  return len > 0.0 ? g / len : glm::dvec3(0.0);
 }
 
 glm::dvec3 VolumeSampler::sigmaA(const glm::dvec3& world) const {
@@ -173,11 +205,17 @@ int splitPatch(const Patch& parent, const VolumeSampler& sampler, SplitAxes axes
   // once so that children sharing a corner get identical bits.
   glm::dvec3 gx[3][3], gw[3][3];
   glm::dvec4 gs[3][3];
+  int gm[3][3];
+  // With sharp interfaces a patch splits only while all its corners are in one material (the
+  // analysis keeps a patch that straddles an interface whole): the new corners are in it too.
+  const bool one_medium = parent.medium[0] == parent.medium[1] && parent.medium[1] == parent.medium[2] &&
+                          parent.medium[2] == parent.medium[3];
   for (int iv = 0; iv <= nv; ++iv) {
     for (int iu = 0; iu <= nu; ++iu) {
       const double u = static_cast<double>(iu) / nu, v = static_cast<double>(iv) / nv;
       gx[iu][iv] = bilinear(parent.x, u, v);
-      gs[iu][iv] = sampler.iorAndGradient(gx[iu][iv]);
+      gm[iu][iv] = one_medium ? parent.medium[0] : sampler.materialAt(gx[iu][iv]);
+      gs[iu][iv] = sampler.materialOptics(gm[iu][iv], gx[iu][iv]);
       gw[iu][iv] = renormalised(bilinear(parent.w, u, v), gs[iu][iv].x);
     }
   }
@@ -191,12 +229,16 @@ int splitPatch(const Patch& parent, const VolumeSampler& sampler, SplitAxes axes
     for (int c = 0; c < 4; ++c) {
       child.x[c] = gx[cu[c]][cv[c]];
       child.w[c] = gw[cu[c]][cv[c]];
+      child.medium[c] = gm[cu[c]][cv[c]];
       if (corner_samples) (*corner_samples)[j][c] = gs[cu[c]][cv[c]];
     }
     child.depth = parent.depth + 0.25 * count;  // +1 for 2×2, +½ for 1×2
     child.n_in = parent.n_in;
     child.cos_in = parent.cos_in;
     child.t_fresnel = parent.t_fresnel;
+    child.reflect_pending = parent.reflect_pending;
+    child.crossed = parent.crossed;
+    child.bounce = parent.bounce;
     areas[j] = child.area();
     child.area0 = areas[j];
     total_area += areas[j];
@@ -289,17 +331,6 @@ int pointLightCubeResolution(double start_radius, const GridSpec& grid, const Si
 
 namespace {
 
-void validateLight(const LightSpec& light) {
-  if (!finite3(light.power)) throw InputError("light", "power", "must be finite");
-  if (light.power.x < 0.0 || light.power.y < 0.0 || light.power.z < 0.0)
-    throw InputError("light", "power", "must not be negative");
-  if (light.type == LightSpec::Type::Directional) {
-    if (!finite3(light.direction) || glm::length(light.direction) == 0.0)
-      throw InputError("light", "direction", "must be a finite, non-zero vector");
-  } else if (!finite3(light.position)) {
-    throw InputError("light", "position", "must be finite");
-  }
-}
 
 // Cells per side for a length: ceil(length/edge), at least 1; an exact multiple (to rounding) is
 // not rounded up.
@@ -308,26 +339,54 @@ int cellsFor(double length, double edge) {
   return n < 1.0 ? 1 : static_cast<int>(n);
 }
 
+// Does the ray origin + t·dir (t ≥ 0) meet the receiver map's rectangle, grown by `margin` (a
+// patch whose midpoint ray passes just outside still covers the border texels)?
+bool rayHitsMap(const glm::dvec3& origin, const glm::dvec3& dir, const ReceiverMap* map, double margin) {
+  if (!map) return false;
+  const double facing = glm::dot(dir, map->normal);
+  if (!(facing < 0.0)) return false;
+  const double t = -glm::dot(origin - map->point, map->normal) / facing;
+  if (!(t >= 0.0)) return false;
+  const glm::dvec2 uv = map->planeCoordinates(origin + t * dir) - map->origin;
+  return uv.x >= -margin && uv.y >= -margin && uv.x <= map->texels.x * map->pitch + margin &&
+         uv.y <= map->texels.y * map->pitch + margin;
+}
+
 std::vector<Patch> directionalPatches(const LightSpec& light, const GridSpec& grid, const VolumeSampler& sampler,
-                                      const SimulationOptions& options) {
+                                      const SimulationOptions& options, const ReceiverMap* map) {
   const glm::dvec3 L = glm::normalize(light.direction);
   glm::dvec3 U, V;
   orthonormalBasis(L, U, V);
   const double h = voxelEdge(grid);
-  const glm::dvec3 lo = grid.bounds_min, hi = grid.bounds_max;
+  glm::dvec3 lo, hi;
+  propagationBox(grid, options, lo, hi);
   double umin = std::numeric_limits<double>::infinity(), umax = -umin, vmin = umin, vmax = -umin, tmin = umin;
-  for (int k = 0; k < 8; ++k) {
-    const glm::dvec3 c((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
+  auto cover = [&](const glm::dvec3& c) {
     umin = std::min(umin, glm::dot(c, U));
     umax = std::max(umax, glm::dot(c, U));
     vmin = std::min(vmin, glm::dot(c, V));
     vmax = std::max(vmax, glm::dot(c, V));
     tmin = std::min(tmin, glm::dot(c, L));
+  };
+  for (int k = 0; k < 8; ++k) cover(glm::dvec3((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z));
+  if (map) {
+    // The receiver's map is lit wholly, also where the box does not shade it.
+    const glm::dvec2 size = glm::dvec2(map->texels) * map->pitch;
+    for (int k = 0; k < 4; ++k) {
+      const glm::dvec2 uv = map->origin + glm::dvec2((k & 1) ? size.x : 0.0, (k & 2) ? size.y : 0.0);
+      cover(map->point + uv.x * map->u + uv.y * map->v);
+    }
   }
   // The plane through the box corner first along L, moved back by ½h.
   const double t0 = tmin - 0.5 * h;
   const double edge = options.patch_voxels * h;
   const int nu = cellsFor(umax - umin, edge), nv = cellsFor(vmax - vmin, edge);
+  if (options.deposit_kernel == DepositKernel::Track) {
+    // Patches of exactly `edge`: a plane wave along a grid axis then meets the deposit lattice
+    // commensurately (track_deposit.h), and neighbouring maps tile alike.
+    umax = umin + nu * edge;
+    vmax = vmin + nv * edge;
+  }
   auto uAt = [&](int i) { return umin + (umax - umin) * (static_cast<double>(i) / nu); };
   auto vAt = [&](int i) { return vmin + (vmax - vmin) * (static_cast<double>(i) / nv); };
   auto point = [&](double u, double v) { return u * U + v * V + t0 * L; };
@@ -342,8 +401,11 @@ std::vector<Patch> directionalPatches(const LightSpec& light, const GridSpec& gr
       Patch p;
       // x₀ = (u₀, v₀), x₁ = (u₁, v₀), x₂ = (u₁, v₁), x₃ = (u₀, v₁): N along L.
       p.x = {point(u0, v0), point(u1, v0), point(u1, v1), point(u0, v1)};
-      if (!rayHitsBox(p.midpoint(), L, lo, hi)) continue;
-      for (int c = 0; c < 4; ++c) p.w[c] = L * sampler.ior(p.x[c]);
+      if (!rayHitsBox(p.midpoint(), L, lo, hi) && !rayHitsMap(p.midpoint(), L, map, edge)) continue;
+      for (int c = 0; c < 4; ++c) {
+        p.medium[c] = sampler.materialAt(p.x[c]);
+        p.w[c] = L * sampler.materialOptics(p.medium[c], p.x[c]).x;
+      }
       p.area0 = p.area();
       p.flux = light.power * p.area0;  // Φ = E_L·A
       row.push_back(p);
@@ -355,7 +417,9 @@ std::vector<Patch> directionalPatches(const LightSpec& light, const GridSpec& gr
 }
 
 std::vector<Patch> pointPatches(const LightSpec& light, const GridSpec& grid, const VolumeSampler& sampler,
-                                const SimulationOptions& options) {
+                                const SimulationOptions& options, const ReceiverMap* map) {
+  glm::dvec3 lo, hi;
+  propagationBox(grid, options, lo, hi);
   const glm::dvec3 p = light.position;
   const double r0 = pointLightStartRadius(p, grid);
   const int m = pointLightCubeResolution(r0, grid, options);
@@ -371,12 +435,14 @@ std::vector<Patch> pointPatches(const LightSpec& light, const GridSpec& grid, co
     auto dirAt = [&](double a, double b) { return glm::normalize(face.normal + a * face.s + b * face.t); };
     for (int i = 0; i < m; ++i) {
       const double a0 = param(i), a1 = param(i + 1);
-      if (!rayHitsBox(p, dirAt(0.5 * (a0 + a1), 0.5 * (b0 + b1)), grid.bounds_min, grid.bounds_max)) continue;
+      const glm::dvec3 centre = dirAt(0.5 * (a0 + a1), 0.5 * (b0 + b1));
+      if (!rayHitsBox(p, centre, lo, hi) && !rayHitsMap(p, centre, map, options.patch_voxels * voxelEdge(grid))) continue;
       const glm::dvec3 dirs[4] = {dirAt(a0, b0), dirAt(a1, b0), dirAt(a1, b1), dirAt(a0, b1)};
       Patch patch;
       for (int c = 0; c < 4; ++c) {
         patch.x[c] = p + r0 * dirs[c];
-        patch.w[c] = sampler.ior(patch.x[c]) * dirs[c];
+        patch.medium[c] = sampler.materialAt(patch.x[c]);
+        patch.w[c] = sampler.materialOptics(patch.medium[c], patch.x[c]).x * dirs[c];
       }
       patch.area0 = patch.area();
       patch.flux = light.power * cubeCellSolidAngle(a0, b0, a1, b1);  // Φ = I·Ω_cell
@@ -390,13 +456,25 @@ std::vector<Patch> pointPatches(const LightSpec& light, const GridSpec& grid, co
 
 }  // namespace
 
+void validateLight(const LightSpec& light) {
+  if (!finite3(light.power)) throw InputError("light", "power", "must be finite");
+  if (light.power.x < 0.0 || light.power.y < 0.0 || light.power.z < 0.0)
+    throw InputError("light", "power", "must not be negative");
+  if (light.type == LightSpec::Type::Directional) {
+    if (!finite3(light.direction) || glm::length(light.direction) == 0.0)
+      throw InputError("light", "direction", "must be a finite, non-zero vector");
+  } else if (!finite3(light.position)) {
+    throw InputError("light", "position", "must be finite");
+  }
+}
+
 std::vector<Patch> initialPatches(const LightSpec& light, const GridSpec& grid, const VolumeSampler& sampler,
-                                  const SimulationOptions& options, double* flux_ref) {
+                                  const SimulationOptions& options, double* flux_ref, const ReceiverMap* map) {
   validateLight(light);
   validateOptions(options);
   std::vector<Patch> patches = light.type == LightSpec::Type::Directional
-                                   ? directionalPatches(light, grid, sampler, options)
-                                   : pointPatches(light, grid, sampler, options);
+                                   ? directionalPatches(light, grid, sampler, options, map)
+                                   : pointPatches(light, grid, sampler, options, map);
   if (flux_ref) {
     double ref = 0.0;
     for (const Patch& patch : patches) ref = std::max(ref, std::max(patch.flux.x, std::max(patch.flux.y, patch.flux.z)));
@@ -407,6 +485,12 @@ std::vector<Patch> initialPatches(const LightSpec& light, const GridSpec& grid, 
 
 // ---------------------------------------------------------------------------------------------
 // Constants of a run
+
+void propagationBox(const GridSpec& grid, const SimulationOptions& options, glm::dvec3& lo, glm::dvec3& hi) {
+  const double margin = options.deposit_kernel == DepositKernel::Track ? voxelEdge(grid) : 0.0;
+  lo = grid.bounds_min - margin;
+  hi = grid.bounds_max + margin;
+}
 
 void validateOptions(const SimulationOptions& o) {
   auto positive = [](double v, const char* name) {

@@ -21,6 +21,7 @@
 #include <glm/glm.hpp>
 
 #include "core/grid.h"
+#include "core/interfaces.h"
 #include "core/volume.h"
 #include "lightsim/simulator.h"
 
@@ -43,6 +44,12 @@ struct Patch {
   double n_in = 0.0;              // n before the boundary layer the patch is in; 0: not in a layer
   double cos_in = 0.0;            // |cos θ| of incidence on entering that layer
   double t_fresnel = 1.0;         // 1 − R applied in the last step (1 when none)
+  // Sharp interfaces (core/interfaces.h; ALGORITHM.md "Sharp interfaces"):
+  std::array<int, 4> medium{-1, -1, -1, -1};  // the material slot each corner is in (−1: air)
+  double reflect_pending = 0.0;   // fraction of the flux reflected at the crossing in progress
+  int crossed = 0;                // corners (bits 0–3) that crossed since that crossing began
+  int bounce = 0;                 // reflections this wavefront has come through
+  int reflections = 0;            // total internal reflections of its corners so far
 
   // m = ¼ Σ x_c
   glm::dvec3 midpoint() const { return 0.25 * (x[0] + x[1] + x[2] + x[3]); }
@@ -96,15 +103,34 @@ class VolumeSampler {
   bool hasAbsorption() const { return !sigma_a_.empty(); }
 
   double ior(const glm::dvec3& world) const;
-  // n and ∇n from one lookup: (n, ∂n/∂x, ∂n/∂y, ∂n/∂z).
+  // n and ∇n from one lookup: (n, ∂n/∂x, ∂n/∂y, ∂n/∂z). With sharp interfaces: those of the
+  // material the point is in (materialOptics(materialAt(world), world)).
   glm::dvec4 iorAndGradient(const glm::dvec3& world) const;
   glm::dvec3 sigmaA(const glm::dvec3& world) const;
+
+  // Sharp interfaces (core/interfaces.h); an empty table and slot −1 everywhere without them.
+  bool sharp() const { return !table_.empty(); }
+  const InterfaceTable& interfaces() const { return table_; }
+  int slotCount() const { return static_cast<int>(table_.slots.size()); }
+  // The slot distances d_k at a point (trilinear, clamp-to-edge); unused slots read +band.
+  glm::dvec4 distances(const glm::dvec3& world) const;
+  // The material slot a point is in (−1: air).
+  int materialAt(const glm::dvec3& world) const { return sharp() ? materialSlot(distances(world), slotCount()) : -1; }
+  // n and ∇n inside material `slot` at `world`: (n_k, 0) for a homogeneous slot, the ior and ior_grad
+  // fields for a graded one, (1, 0) for air (−1). Without sharp interfaces: iorAndGradient.
+  glm::dvec4 materialOptics(int slot, const glm::dvec3& world) const;
+  bool opaque(int slot) const { return slot >= 0 && table_.slots[static_cast<std::size_t>(slot)].opaque; }
+  // The outward unit normal of slot k's surface near `world`: ∇d_k by central differences of half a
+  // voxel; (0, 0, 0) where the distance is flat (far outside the band).
+  glm::dvec3 interfaceNormal(int slot, const glm::dvec3& world) const;
 
  private:
   GridSpec grid_;
   double h_ = 0.0;
   std::vector<glm::vec4> ior_grad_;  // (n, ∇n) per voxel
   std::vector<glm::vec3> sigma_a_;   // empty: no absorption
+  InterfaceTable table_;
+  std::vector<glm::vec4> distances_; // empty without sharp interfaces
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -218,8 +244,15 @@ constexpr int kMaxCubeResolution = 2048;
 // map (M = 2048). A directional light always meets the box. Zero power is allowed here (patches
 // that carry nothing); parseLight rejects it. Throws InputError for an unusable light (zero or non-finite direction or position,
 // negative or non-finite power) and for bad options (validateOptions).
+// Throws InputError for an unusable light: zero or non-finite direction or position, negative or
+// non-finite power.
+void validateLight(const LightSpec& light);
+
+// With a receiver map (receiver.h), the patches also cover the map wholly: those whose ray meets the
+// map but not the box go straight to it.
 std::vector<Patch> initialPatches(const LightSpec& light, const GridSpec& grid, const VolumeSampler& sampler,
-                                  const SimulationOptions& options, double* flux_ref);
+                                  const SimulationOptions& options, double* flux_ref,
+                                  const ReceiverMap* map = nullptr);
 
 // ---------------------------------------------------------------------------------------------
 // Constants of a run.
@@ -228,6 +261,9 @@ std::vector<Patch> initialPatches(const LightSpec& light, const GridSpec& grid, 
 // non-finite step, patch or split size; max_depth < 0 or > 16; a negative threshold or max_steps;
 // negative boundary thresholds or boundary_off > boundary_on.
 void validateOptions(const SimulationOptions& options);
+// The box patches live in: the grid's, grown by one voxel with DepositKernel::Track, so that the
+// hats of the outermost voxels (which reach half a voxel past the grid) get every path through them.
+void propagationBox(const GridSpec& grid, const SimulationOptions& options, glm::dvec3& lo, glm::dvec3& hi);
 // Δt = step_voxels·h.
 double timeStep(const GridSpec& grid, const SimulationOptions& options);
 // options.max_steps, or when 0: ceil(4 × grid diagonal / Δt).

@@ -333,7 +333,7 @@ TEST(Initialisation, DirectionalStraightDownCoversTheBoxExactly) {
   light.direction = {0, -1, 0};
   light.power = {2.0, 1.0, 0.5};
   double ref = 0.0;
-  const auto patches = initialPatches(light, g, s, SimulationOptions{}, &ref);
+  const auto patches = initialPatches(light, g, s, test_scenes::pointDepositOptions(), &ref);
   ASSERT_EQ(patches.size(), 16u * 16u);
   glm::dvec3 total(0.0);
   for (const Patch& p : patches) {
@@ -363,7 +363,7 @@ TEST(Initialisation, DirectionalObliqueFluxIsIrradianceTimesProjectedArea) {
   LightSpec light;
   light.direction = glm::normalize(glm::dvec3(1.0, -2.0, 0.5));
   light.power = glm::dvec3(3.0);
-  SimulationOptions options;
+  SimulationOptions options = test_scenes::pointDepositOptions();
   const auto patches = initialPatches(light, g, s, options, nullptr);
   const glm::dvec3 L = light.direction, e = g.extent();
   const double projected = std::fabs(L.x) * e.y * e.z + std::fabs(L.y) * e.x * e.z + std::fabs(L.z) * e.x * e.y;
@@ -414,7 +414,7 @@ TEST(Initialisation, PointLightFarAwaySeesTheBoxSolidAngle) {
   light.type = LightSpec::Type::Point;
   light.position = {0.0, 8.0, 0.0};
   light.power = glm::dvec3(5.0);
-  const auto patches = initialPatches(light, g, s, SimulationOptions{}, nullptr);
+  const auto patches = initialPatches(light, g, s, test_scenes::pointDepositOptions(), nullptr);
   const double r0 = pointLightStartRadius(light.position, g);
   EXPECT_NEAR(r0, 7.5 - s.h(), 1e-12);
   double omega = 0.0, edge = 0.0;
@@ -442,7 +442,7 @@ TEST(Initialisation, PointLightInsideTheBoxEmitsFourPiI) {
   light.type = LightSpec::Type::Point;
   light.position = {0.1, -0.2, 0.05};
   light.power = {2.0, 1.0, 0.25};
-  SimulationOptions options;
+  SimulationOptions options = test_scenes::pointDepositOptions();
   options.patch_voxels = 0.2;  // a finer start than the default, to exercise M > 1
   double ref = 0.0;
   const auto patches = initialPatches(light, g, s, options, &ref);
@@ -488,7 +488,7 @@ TEST(Initialisation, RejectsBadLightsAndOptions) {
   // Zero power is not an error here (parseLight rejects it): patches that carry nothing.
   light.power = glm::dvec3(0.0);
   double ref = 1.0;
-  EXPECT_EQ(initialPatches(light, g, s, {}, &ref).size(), 64u);
+  EXPECT_EQ(initialPatches(light, g, s, test_scenes::pointDepositOptions(), &ref).size(), 64u);
   EXPECT_EQ(ref, 0.0);
 }
 

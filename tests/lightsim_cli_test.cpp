@@ -30,8 +30,8 @@ TEST(LightsimCli, BakesOnBothBackends) {
     const std::string out = std::string("baked_") + backend + ".vol.json";
     ProgramResult r = runProgram(LIGHTSIM_EXE,
                                  {"ball.vol.json", "-o", out, "--light", "directional:0,-1,0", "--power", "2,2,2",
-                                  "--backend", backend, "--max-depth", "3", "--at-max-depth", "kill", "--stats", "stats.json",
-                                  "--quiet"},
+                                  "--backend", backend, "--deposit-kernel", "point", "--max-depth", "3", "--at-max-depth",
+                                  "kill", "--stats", "stats.json", "--quiet"},
                                  dir.path());
     ASSERT_EQ(r.exit_code, 0) << backend << ": " << r.output;
     Volume v = readVolume(dir / out);
@@ -55,7 +55,7 @@ TEST(LightsimCli, AutoBackendPicksTheTwinOnASoftwareRasterizer) {
   makeSphere(dir);
   ProgramResult r = runProgram(LIGHTSIM_EXE,
                                {"ball.vol.json", "-o", "auto.vol.json", "--light", "directional:0,-1,0", "--backend",
-                                "auto", "--max-depth", "2", "--stats", "auto.json"},
+                                "auto", "--deposit-kernel", "point", "--max-depth", "2", "--stats", "auto.json"},
                                dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("--backend auto:"), std::string::npos) << r.output;
@@ -63,6 +63,25 @@ TEST(LightsimCli, AutoBackendPicksTheTwinOnASoftwareRasterizer) {
   const bool software = r.output.find("llvmpipe") != std::string::npos ||
                         r.output.find("no OpenGL context") != std::string::npos;
   EXPECT_EQ(stats["backend"], software ? "cpu" : "gl") << r.output;
+}
+
+// What the GPU path cannot do yet (track deposits, sharp interfaces, receiver maps): auto takes the
+// twin and says why; an explicit --backend gl is refused (exit 2) before any work.
+TEST(LightsimCli, TheGpuPathRefusesWhatItCannotDoYet) {
+  TempDir dir;
+  makeSphere(dir);
+  ProgramResult r = runProgram(LIGHTSIM_EXE,
+                               {"ball.vol.json", "-o", "t.vol.json", "--light", "directional:0,-1,0", "--max-depth", "2",
+                                "--stats", "t.json"},
+                               dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("the GPU path does not do track deposits"), std::string::npos) << r.output;
+  EXPECT_EQ(nlohmann::json::parse(readFile(dir / "t.json"))["backend"], "cpu");
+  r = runProgram(LIGHTSIM_EXE, {"ball.vol.json", "-o", "g.vol.json", "--light", "directional:0,-1,0", "--backend", "gl"},
+                 dir.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--backend: gl: the GPU path does not do track deposits"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "g.vol.json"));
 }
 
 // --smooth-irradiance is a normalised filter: the light's total stays (the sphere sits well inside
@@ -102,7 +121,8 @@ TEST(LightsimCli, BenchRepeatsTheBakeAndReportsItsFigures) {
   for (const char* backend : {"cpu", "gl"}) {
     ProgramResult r = runProgram(LIGHTSIM_EXE,
                                  {"ball.vol.json", "-o", "b.vol.json", "--light", "directional:0,-1,0", "--backend",
-                                  backend, "--max-depth", "2", "--bench", "3", "--stats", "bench.json", "--quiet"},
+                                  backend, "--deposit-kernel", "point", "--max-depth", "2", "--bench", "3", "--stats",
+                                  "bench.json", "--quiet"},
                                  dir.path());
     ASSERT_EQ(r.exit_code, 0) << backend << ": " << r.output;
     EXPECT_NE(r.output.find("lightsim bench:"), std::string::npos) << r.output;

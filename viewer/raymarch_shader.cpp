@@ -1,6 +1,8 @@
 // Assembly of the viewer's ray-casting shader (see raymarch_shader.h).
 #include "viewer/raymarch_shader.h"
 
+#include <cstdio>
+
 #include <algorithm>
 #include <regex>
 #include <sstream>
@@ -130,6 +132,7 @@ gl::ShaderSource raymarchFragmentSource(const gl::ShaderLibrary& shaders, const 
     for (const std::string& function : accessor_functions) scope += "#define " + function + " " + function + index + "\n";
     scope += objects[k].layout.glslDefines();
     if (objects[k].sharp_faces) scope += "#define SHARP_FACES 1\n";
+    scope += objects[k].defines;
     const std::vector<std::string> names = definedNames(scope);
 
     out += scope;
@@ -145,6 +148,29 @@ gl::ShaderSource raymarchFragmentSource(const gl::ShaderLibrary& shaders, const 
   const std::size_t line_end = source.text.find('\n', marker);
   source.text.replace(marker, line_end == std::string::npos ? std::string::npos : line_end + 1 - marker, out);
   return source;
+}
+
+std::string objectReceiverSampler(std::size_t object) { return "uO" + std::to_string(object) + "Receiver"; }
+
+std::string interfaceDefines(const InterfaceTable& table) {
+  if (table.empty()) return "";
+  auto vec4Of = [&](auto value) {
+    std::string text = "vec4(";
+    for (int k = 0; k < 4; ++k) {
+      char number[32];
+      std::snprintf(number, sizeof number, "%.9g", k < static_cast<int>(table.slots.size())
+                                                      ? static_cast<double>(value(table.slots[static_cast<std::size_t>(k)]))
+                                                      : 0.0);
+      text += std::string(k ? ", " : "") + number;
+    }
+    return text + ")";
+  };
+  std::string out = "#define INTERFACE_SLOTS " + std::to_string(table.slots.size()) + "\n";
+  out += "#define SLOT_IOR " + vec4Of([](const InterfaceSlot& s) { return s.ior; }) + "\n";
+  out += "#define SLOT_DISPERSION " + vec4Of([](const InterfaceSlot& s) { return s.dispersion_b; }) + "\n";
+  out += "#define SLOT_GRADED " + vec4Of([](const InterfaceSlot& s) { return s.graded ? 1.0 : 0.0; }) + "\n";
+  out += "#define SLOT_OPAQUE " + vec4Of([](const InterfaceSlot& s) { return s.opaque ? 1.0 : 0.0; }) + "\n";
+  return out;
 }
 
 }  // namespace eik

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "core/interfaces.h"
 #include "gl/shader_library.h"
 #include "gl/shader_source.h"
 #include "gl/volume_textures.h"
@@ -50,7 +51,18 @@ gl::ShaderDefines raymarchDefines(const RenderSettings& settings, const Raymarch
 struct RaymarchObject {
   gl::VolumeTextureLayout layout;  // of its volume's textures
   bool sharp_faces = false;        // the material touches the box (volume_analysis.h): SHARP_FACES
+  // Further #define lines of its scope (#undef'd after it): its sharp interfaces' slots
+  // (INTERFACE_SLOTS, SLOT_IOR, ...; interfaceDefines) and HAS_RECEIVER.
+  std::string defines;
 };
+
+// The per-object defines of a volume's sharp interfaces (core/interfaces.h): INTERFACE_SLOTS (the
+// slot count), SLOT_IOR, SLOT_DISPERSION, SLOT_GRADED and SLOT_OPAQUE (vec4 literals, one entry a
+// slot); "" for a table without slots.
+std::string interfaceDefines(const InterfaceTable& table);
+
+// The sampler uniform of object k's receiver map (HAS_RECEIVER).
+std::string objectReceiverSampler(std::size_t object);
 
 // raymarch.frag with `defines`, its segments filled for `objects` (in the scene's order; at least
 // one). RuntimeError when a template lacks its segment.

@@ -32,7 +32,7 @@ std::size_t occurrences(const std::string& text, const std::string& part) {
 }
 
 RaymarchObject glassObject() {
-  return {gl::VolumeTextureLayout::plan({{"ior", 1}, {"ior_grad", 3}}, true), false};
+  return {gl::VolumeTextureLayout::plan({{"ior", 1}, {"ior_grad", 3}}, true), false, ""};
 }
 
 TEST(RaymarchDefines, FollowTheSettingsAndTheScene) {
@@ -101,8 +101,8 @@ TEST(RaymarchShader, ThreeObjectsEachInItsOwnScope) {
                             {{"ior", 1}, {"ior_grad", 3}, {"sigma_a", 3}, {"scatter", 2}, {"irradiance", 3},
                              {"light_dir", 3}},
                             true),
-                        true};
-  RaymarchObject prism{gl::VolumeTextureLayout::plan({{"ior", 1}, {"ior_grad", 3}, {"dispersion", 1}}, true), false};
+                        true, ""};
+  RaymarchObject prism{gl::VolumeTextureLayout::plan({{"ior", 1}, {"ior_grad", 3}, {"dispersion", 1}}, true), false, ""};
   const gl::ShaderSource source =
       raymarchFragmentSource(shaders, raymarchDefines(RenderSettings{}, scene), {glassObject(), medium, prism});
   const std::string& text = source.text;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/interfaces.h"
 #include "gl/framebuffer.h"
 #include "gl/gl.h"
 #include "gl/program.h"
@@ -17,6 +18,18 @@
 #include "viewer/volume_analysis.h"
 
 namespace eik {
+
+namespace {
+
+// RGB texels → RGBA (alpha 1): llvmpipe samples RGBA32F faster than RGB32F.
+std::vector<float> padRgba(const std::vector<float>& rgb) {
+  std::vector<float> rgba(rgb.size() / 3 * 4, 1.0f);
+  for (std::size_t t = 0; t < rgb.size() / 3; ++t)
+    for (int c = 0; c < 3; ++c) rgba[4 * t + static_cast<std::size_t>(c)] = rgb[3 * t + static_cast<std::size_t>(c)];
+  return rgba;
+}
+
+}  // namespace
 
 struct SceneRenderer::Impl {
   struct Object {
@@ -31,6 +44,13 @@ struct SceneRenderer::Impl {
     bool sharp_faces = false;  // materialTouchesBox
     gl::Texture3D bricks;  // homogeneousBricks, nearest filtering
     glm::ivec3 brick_dims{0};
+    std::string defines;   // RaymarchObject::defines: its interfaces, HAS_RECEIVER
+    // The receiver map of the scene's ground, when its bake made one (volume space).
+    bool has_receiver = false;
+    ReceiverMap receiver;   // geometry (the data is in receiver_texture)
+    gl::Texture2D receiver_texture;
+    glm::vec4 receiver_light_pos{0.0f};
+    glm::vec3 receiver_light_power{0.0f};
   };
 
   const gl::ShaderLibrary& shaders;
@@ -46,6 +66,39 @@ struct SceneRenderer::Impl {
 
   Impl(const gl::ShaderLibrary& library, const LoadedScene& loaded)
       : shaders(library), scene(loaded.scene), environment(loaded.scene.environment, loaded.scene.base_dir, loaded.source) {}
+
+  // The object's receiver map of the scene's ground (core/receiver_map.h), if its volume has one in
+  // the ground's plane (in the volume's own space), with the light it was baked with.
+  static void attachReceiver(Object& o, const LoadedObject& loaded, const SceneGroundSpec& ground) {
+    const glm::dvec3 point = glm::dvec3(o.to_volume * glm::dvec4(ground.point, 1.0));
+    const glm::dvec3 normal = glm::normalize(glm::transpose(glm::dmat3(o.to_world)) * ground.normal);
+    for (const ReceiverMap& map : loaded.volume.receivers) {
+      const double scale = map.pitch * 4.0;
+      if (glm::dot(normal, map.normal) < 0.9999 || std::abs(glm::dot(point - map.point, map.normal)) > scale) continue;
+      const nlohmann::json& light = loaded.volume.metadata.value("light", nlohmann::json());
+      if (!light.is_object() || !light.contains("type")) continue;
+      auto vec3Of = [&](const char* key) {
+        const nlohmann::json& a = light.at(key);
+        return glm::vec3(a.at(0).get<float>(), a.at(1).get<float>(), a.at(2).get<float>());
+      };
+      try {
+        if (light.at("type") == "directional") {
+          o.receiver_light_pos = glm::vec4(glm::normalize(vec3Of("direction")), 0.0f);
+          o.receiver_light_power = vec3Of("irradiance");
+        } else {
+          o.receiver_light_pos = glm::vec4(vec3Of("position"), 1.0f);
+          o.receiver_light_power = vec3Of("intensity");
+        }
+      } catch (const nlohmann::json::exception&) {
+        throw InputError(loaded.source, "light", "the baked light is malformed");
+      }
+      o.receiver = map;
+      o.receiver.irradiance.clear();
+      o.receiver_texture = gl::Texture2D(map.texels, gl::TextureFormat::RGBA32F, padRgba(map.irradiance), 4);
+      o.has_receiver = true;
+      return;
+    }
+  }
 
   gl::ShaderDefines defines() const {
     RaymarchScene variant;
@@ -63,7 +116,7 @@ struct SceneRenderer::Impl {
     for (const auto& [name, value] : defs) key += name + "=" + value + ";";
     if (program && key == program_key) return;
     std::vector<RaymarchObject> shapes;
-    for (const Object& o : objects) shapes.push_back({o.textures.layout(), o.sharp_faces});
+    for (const Object& o : objects) shapes.push_back({o.textures.layout(), o.sharp_faces, o.defines});
     gl::ShaderSource vertex = shaders.source("common/fullscreen.vert");
     program = gl::Program(vertex, raymarchFragmentSource(shaders, defs, shapes));
     program_key = key;
@@ -109,6 +162,18 @@ struct SceneRenderer::Impl {
       o.bricks.bind(unit);
       p.setSampler(objectBricksSampler(k), unit);
       ++unit;
+      if (o.has_receiver) {
+        o.receiver_texture.bind(unit);
+        p.setSampler(objectReceiverSampler(k), unit);
+        ++unit;
+        p.set("uObjRecvPoint" + i, glm::vec3(o.receiver.point));
+        p.set("uObjRecvU" + i, glm::vec3(o.receiver.u));
+        p.set("uObjRecvV" + i, glm::vec3(o.receiver.v));
+        p.set("uObjRecvOrigin" + i, glm::vec2(o.receiver.origin));
+        p.set("uObjRecvSize" + i, glm::vec2(glm::dvec2(o.receiver.texels) * o.receiver.pitch));
+        p.set("uObjRecvLightPos" + i, o.receiver_light_pos);
+        p.set("uObjRecvLightPower" + i, o.receiver_light_power);
+      }
       p.set("uObjBrickSize" + i, glm::vec3(o.grid.extent() / glm::dvec3(o.grid.dims) * double(kBrickVoxels)));
     }
 
@@ -180,6 +245,12 @@ SceneRenderer::SceneRenderer(const gl::ShaderLibrary& shaders, const LoadedScene
     if (!ior || !grad || ior->texture != grad->texture || ior->channel != 0 || grad->channel != 1)
       throw RuntimeError("viewer: expected ior and ior_grad together in one RGBA texture");
     units += o.textures.layout().textureCount() + 1;
+    o.defines = interfaceDefines(interfaceTable(loaded.volume, loaded.source));
+    if (scene.scene.ground) Impl::attachReceiver(o, loaded, *scene.scene.ground);
+    if (o.has_receiver) {
+      o.defines += "#define HAS_RECEIVER 1\n";
+      ++units;
+    }
     {
       const std::vector<float> bricks = homogeneousBricks(loaded.volume, o.brick_dims);
       o.bricks = gl::Texture3D(o.brick_dims, gl::TextureFormat::R32F, bricks, 1, gl::Sampling{gl::Filter::Nearest});

@@ -13,6 +13,39 @@ namespace eik {
 
 using glm::dvec3;
 
+namespace {
+
+// Region::distance (and ior_at_center) at every voxel centre within `band` of the solid's bounds:
+// the distance function clamped to ±band, which is exact near the surface (the band is what the
+// programs interpolate across an interface) and only a bound farther out.
+void recordDistance(const ImplicitSolid& solid, const GridSpec& grid, double band, Region& region) {
+  region.distance.assign(grid.count(), static_cast<float>(band));
+  const bool graded = static_cast<bool>(solid.ior);
+  if (graded) region.ior_at_center.assign(grid.count(), solid.material.ior);
+  if (grid.count() == 0 || solid.bounds.empty()) return;
+  const dvec3 h = grid.voxelSize();
+  glm::ivec3 lo, hi;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = std::clamp(static_cast<int>(std::floor((solid.bounds.min[a] - band - grid.bounds_min[a]) / h[a])) - 1, 0,
+                       grid.dims[a]);
+    hi[a] = std::clamp(static_cast<int>(std::ceil((solid.bounds.max[a] + band - grid.bounds_min[a]) / h[a])) + 1, 0,
+                       grid.dims[a]);
+  }
+  parallelFor(lo.z, hi.z, [&](std::int64_t zz) {
+    const int k = static_cast<int>(zz);
+    for (int j = lo.y; j < hi.y; ++j)
+      for (int i = lo.x; i < hi.x; ++i) {
+        const dvec3 c = grid.center(i, j, k);
+        const double d = solid.sdf(c);
+        const std::size_t at = grid.index(i, j, k);
+        region.distance[at] = static_cast<float>(std::clamp(d, -band, band));
+        if (graded && d < band) region.ior_at_center[at] = static_cast<float>(std::max(1.0, solid.ior(c)));
+      }
+  });
+}
+
+}  // namespace
+
 Region voxelizeImplicit(const ImplicitSolid& solid, const GridSpec& grid, const ProceduralOptions& options,
                         const ProgressFn& progress) {
   const int supersample = options.supersample;
@@ -95,6 +128,8 @@ Region voxelizeImplicit(const ImplicitSolid& solid, const GridSpec& grid, const 
     }
     if (progress) progress(static_cast<double>(++slices_done) / slices);
   });
+
+  if (options.distance_band > 0.0) recordDistance(solid, grid, options.distance_band, region);
 
   if (!solid.open_surface) {
     double sum = 0.0;  // serial, so the result does not depend on the thread count

@@ -27,6 +27,9 @@ struct ProceduralOptions {
   // an axis, and it removes the 1/S³ quantisation noise that otherwise tilts ∇n by ~2° after
   // smoothing (measured on a 128³ sphere). Both estimators converge to the exact occupancy.
   bool antialias = true;
+  // > 0: also record Region::distance (and ior_at_center for a graded solid) for sharp interfaces,
+  // clamped to ± this many world units.
+  double distance_band = 0.0;
 };
 
 // A solid given by a signed distance function: negative inside, and 1-Lipschitz (|sdf(p)| is at

@@ -1,6 +1,7 @@
 // voxelize: meshes (glTF 2.0, OBJ) and procedural shapes -> a material volume (docs/volume-format.md, docs/programs.md).
 //
-//   voxelize INPUT... -o OUT.vol.json [--res N] [--bounds ...] [--pad VOXELS] [--smooth SIGMA]
+//   voxelize INPUT... -o OUT.vol.json [--res N] [--bounds ...] [--pad VOXELS] [--interfaces sharp|smooth]
+//            [--smooth SIGMA]
 //            [--material KEY=VALUE,...] [--stats FILE.json] [--quiet]
 //
 // This file only reads the command line; the work itself is voxelizeFiles (pipeline.h), which
@@ -37,8 +38,8 @@ int run(int argc, char** argv) {
   bool list_shapes = false;
   CLI::App app{
       "voxelize: turn meshes (glTF 2.0, OBJ) and procedural shapes into a material volume\n"
-      "(refractive index n pre-smoothed with a Gaussian, its gradient, absorption, emission,\n"
-      "scattering, opaque parts) for lightsim and viewer. Thesis §3.1 and §6.1.",
+      "(refractive index n with sharp interfaces, or pre-smoothed with a Gaussian, its gradient,\n"
+      "absorption, emission, scattering, opaque parts) for lightsim and viewer. Thesis §3.1 and §6.1.",
       "voxelize"};
   app.add_option("inputs", o.inputs,
                  "mesh.gltf | mesh.glb | mesh.obj | procedural:NAME[,key=value...] (several allowed; "
@@ -48,7 +49,15 @@ int run(int argc, char** argv) {
       ->check(CLI::Range(1, kMaxGridDim));
   app.add_option("--bounds", o.bounds, "explicit world box MINX,MINY,MINZ,MAXX,MAXY,MAXZ (no padding added)");
   app.add_option("--pad", o.pad, "voxels of air around the objects (default 3)");
-  app.add_option("--smooth", o.smooth, "sigma of the Gaussian pre-smoothing of n, in voxels (default 0.75; 0: none)");
+  app.add_option("--interfaces", o.interfaces,
+                 "sharp (default: material boundaries stay sharp, recorded as signed distances; lightsim and "
+                 "viewer apply Snell's law and Fresnel there) or smooth (the thesis: n pre-smoothed with a "
+                 "Gaussian, Eq. 3.2)")
+      ->check(CLI::IsMember({"sharp", "smooth"}));
+  CLI::Option* smooth =
+      app.add_option("--smooth", o.smooth,
+                     "sigma of the Gaussian pre-smoothing of n in voxels, for --interfaces smooth (default 0.75; "
+                     "0: none); given alone it selects --interfaces smooth");
   app.add_option("--material", o.materials,
                  "material of OBJ and procedural inputs: KEY=VALUE[,KEY=VALUE...] with keys ior, "
                  "sigma_a=R:G:B, emission=R:G:B, albedo=R:G:B (opaque), scatter, g, abbe, name. Given once "
@@ -73,6 +82,11 @@ int run(int argc, char** argv) {
       "  voxelize bunny.obj --material ior=1.55,sigma_a=0.2:0.6:1.4 -o bunny.vol.json\n"
       "Exit codes: 0 success, 1 runtime failure, 2 bad usage or bad input.");
   if (!parseCommandLine(app, argc, argv)) return kExitOk;
+  if (smooth->count() > 0) {
+    if (app.count("--interfaces") > 0 && o.interfaces == "sharp")
+      throw InputError("--smooth", "", "smooths n, which --interfaces sharp keeps sharp: give one of them");
+    o.interfaces = "smooth";
+  }
   if (list_shapes) {
     std::printf("%s", shapeHelp().c_str());
     return kExitOk;

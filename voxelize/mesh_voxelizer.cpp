@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/stopwatch.h"
+#include "voxelize/mesh_distance.h"
 #include "voxelize/solid_voxelizer.h"
 #include "voxelize/surface_voxelizer.h"
 
@@ -82,6 +83,12 @@ bool classifyOpenSurface(const SheetMeasures& m, const GridSpec& grid, const Mes
   return surface;
 }
 
+// The mean voxel edge, the surface voxeliser's unit of thickness.
+double meanVoxelEdge(const GridSpec& grid) {
+  const glm::dvec3 h3 = grid.voxelSize();
+  return (h3.x + h3.y + h3.z) / 3.0;
+}
+
 }  // namespace
 
 bool isOpenSurface(const TriangleMesh& mesh, const GridSpec& grid, const MeshVoxelizeOptions& options,
@@ -137,6 +144,12 @@ Region voxelizeMesh(const TriangleMesh& mesh, const GridSpec& grid, const MeshVo
     double sum = 0.0;
     for (float c : region.coverage) sum += c;
     region.enclosed_volume = sum * grid.voxelVolume();
+  }
+  if (options.distance_band > 0.0) {
+    region.distance =
+        surface ? sheetSignedDistance(mesh, grid, options.distance_band,
+                                      std::max(options.surface_thickness_voxels, 0.0) * meanVoxelEdge(grid))
+                : meshSignedDistance(mesh, grid, options.distance_band, region.coverage);
   }
   stats.seconds = clock.seconds();
   if (stats_out) *stats_out = stats;

@@ -37,6 +37,9 @@ struct MeshVoxelizeOptions {
   bool majority_vote = false;
   double winding_threshold = 0.5;         // inside where the generalized winding number exceeds this
   double winding_beta = 2.0;              // Barnes–Hut accuracy of the winding number (larger: exacter)
+  // > 0: also record Region::distance, the narrow-band signed distance (mesh_distance.h), clamped
+  // to ± this many world units, for sharp interfaces.
+  double distance_band = 0.0;
 };
 
 // What happened, for --stats and the lead's report.

@@ -19,8 +19,14 @@
 #include "voxelize/mesh_voxelizer.h"
 #include "voxelize/procedural.h"
 #include "voxelize/scene_export.h"
+#include "voxelize/sharp_interfaces.h"
 
 namespace eik {
+
+double interfaceBand(const GridSpec& grid) {
+  const glm::dvec3 h = grid.voxelSize();
+  return kInterfaceBandVoxels * std::max(h.x, std::max(h.y, h.z));
+}
 
 Volume buildVolume(const std::vector<Region>& regions, const GridSpec& grid, const PipelineOptions& options) {
   // Progress: compositing is about half the work, smoothing and the gradient the rest.
@@ -31,6 +37,11 @@ Volume buildVolume(const std::vector<Region>& regions, const GridSpec& grid, con
   CompositeOptions composite;
   composite.all_fields = options.all_fields;
   composite.progress = report(0.0, 0.5);
+  if (options.interfaces == InterfaceMode::Sharp) {
+    Volume volume = buildSharpVolume(regions, grid, options.band > 0.0 ? options.band : interfaceBand(grid), composite);
+    if (options.progress) options.progress(1.0);
+    return volume;
+  }
   Volume volume = compositeRegions(regions, grid, composite);
 
   Field& ior = volume.fields.at("ior");
@@ -104,6 +115,8 @@ void checkOptions(const VoxelizeOptions& o) {
     if (!fs::is_directory(dir)) throw InputError(*path, "", "directory " + dir.string() + " does not exist");
   }
   if (!(o.smooth >= 0) || o.smooth > 8) throw InputError("--smooth", "", "must be in [0, 8] voxels");
+  if (o.interfaces != "sharp" && o.interfaces != "smooth")
+    throw InputError("--interfaces", o.interfaces, "expected sharp or smooth");
 }
 
 // 1. Read every input; validate everything before any heavy work.
@@ -176,9 +189,11 @@ std::vector<Region> voxelizeObjects(const std::vector<Input>& inputs, const Grid
     for (std::size_t i = 0; i < inputs.size(); ++i) {
       const Input& in = inputs[i];
       ProgressFn progress = [&bar, i, share](double f) { bar.update((static_cast<double>(i) + f) * share); };
+      const double band = o.interfaces == "sharp" ? interfaceBand(grid) : 0.0;
       if (in.procedural) {
         ProceduralOptions options;
         options.supersample = o.supersample;
+        options.distance_band = band;
         for (Region& r : voxelizeProcedural(*in.procedural, grid, options, progress)) {
           objects_stats.push_back({{"input", in.source}, {"region", r.name}, {"enclosed_volume", r.enclosed_volume}});
           regions.push_back(std::move(r));
@@ -186,6 +201,7 @@ std::vector<Region> voxelizeObjects(const std::vector<Input>& inputs, const Grid
       } else {
         MeshVoxelizeOptions options;
         options.supersample = o.supersample;
+        options.distance_band = band;
         options.surface_mode = o.surface == "solid" ? SurfaceMode::Solid
                                : o.surface == "surface" ? SurfaceMode::Surface
                                                         : SurfaceMode::Auto;
@@ -214,6 +230,7 @@ std::vector<Region> voxelizeObjects(const std::vector<Input>& inputs, const Grid
 Volume buildFields(std::vector<Region>& regions, const GridSpec& grid, const VoxelizeOptions& o, json& stats) {
   const Stopwatch clock;
   PipelineOptions pipeline;
+  pipeline.interfaces = o.interfaces == "sharp" ? InterfaceMode::Sharp : InterfaceMode::Smooth;
   pipeline.smooth_sigma_voxels = o.smooth;
   ProgressBar fields_bar("n and grad n", !o.quiet);
   pipeline.progress = fields_bar.callback();

@@ -17,20 +17,30 @@
 
 namespace eik {
 
+enum class InterfaceMode { Sharp, Smooth };
+
 struct PipelineOptions {
+  // Sharp (default): buildSharpVolume (sharp_interfaces.h); every region must carry its distance.
+  // Smooth: the thesis' pre-smoothed n, below.
+  InterfaceMode interfaces = InterfaceMode::Smooth;  // TODO(exact-optics): Sharp once lightsim and viewer read it
+  double band = 0.0;  // Sharp: the distance band in world units (0: kInterfaceBandVoxels voxels)
   double smooth_sigma_voxels = kDefaultSmoothSigmaVoxels;  // σ of the pre-smoothing of n; 0: none
   GradientOperator gradient = GradientOperator::Isotropic;  // how ∇n is differenced (field_filters.h)
   bool all_fields = false;                                 // see CompositeOptions::all_fields
   ProgressFn progress;
 };
 
-// compositeRegions → gaussianSmooth(ior, σ) → ior_grad = gradient(ior) (Eq. 3.1; by default with
+// Sharp: buildSharpVolume. Smooth: compositeRegions → gaussianSmooth(ior, σ) → ior_grad = gradient(ior) (Eq. 3.1; by default with
 // the isotropic cross-average, see field_filters.h).
 // Only n (and the Cauchy B of `dispersion`, which is part of n(λ)) is smoothed, as in the thesis:
 // σa, emission, scatter and opaque keep their sharp box-filtered boundaries (they enter the image
 // linearly, so blocky edges do not bend rays).
 // metadata["ior_smoothing_sigma_voxels"] records σ, metadata["ior_gradient"] the operator.
 Volume buildVolume(const std::vector<Region>& regions, const GridSpec& grid, const PipelineOptions& options = {});
+
+// The default band of the sharp interfaces' distance field: kInterfaceBandVoxels of the largest
+// voxel edge, in world units.
+double interfaceBand(const GridSpec& grid);
 
 // What `voxelize` is asked to do: its command line (docs/programs.md), flag by flag.
 struct VoxelizeOptions {
@@ -39,7 +49,8 @@ struct VoxelizeOptions {
   int res = 128;                    // voxels along the longest axis of the objects
   std::string bounds;               // explicit world box "MINX,MINY,MINZ,MAXX,MAXY,MAXZ" (empty: from the objects)
   double pad = kDefaultPadVoxels;   // voxels of air around the objects
-  double smooth = kDefaultSmoothSigmaVoxels;  // σ of the pre-smoothing of n, in voxels
+  std::string interfaces = "smooth";  // sharp or smooth (the thesis' pre-smoothed n)
+  double smooth = kDefaultSmoothSigmaVoxels;  // σ of the pre-smoothing of n, in voxels (smooth mode)
   std::vector<std::string> materials;  // --material specs: one for all OBJ/procedural inputs, or one each
   int supersample = 4;              // sub-samples per voxel and axis
   std::string surface = "auto";     // how meshes are read: auto, solid or surface

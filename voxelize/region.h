@@ -18,6 +18,13 @@ struct Region {
   // Optional spatially varying refractive index (Luneburg lens, gradient slab): the mean n over the
   // covered part of each voxel. Empty: the material's constant ior.
   std::vector<float> ior;
+  // Sharp interfaces (core/interfaces.h): the signed distance from each voxel centre to the
+  // object's surface in world units, negative inside, clamped to ±band. Empty when not asked for.
+  std::vector<float> distance;
+  // A graded object (non-empty `ior`) in sharp mode: n at each voxel centre inside the object and
+  // within the band around it, the material's n(x) continued across the surface, so that n and ∇n
+  // near the surface come without the jump to the neighbouring material.
+  std::vector<float> ior_at_center;
   // World-space volume enclosed by the object (for the innermost-wins rule and --stats). An open
   // surface (receiver layer) has 0 and so always wins over the solids around it.
   double enclosed_volume = 0.0;

@@ -33,6 +33,9 @@ uniform sampler3D uVolumeTex6;
 #if VOLUME_TEXTURE_COUNT > 7
 uniform sampler3D uVolumeTex7;
 #endif
+#if VOLUME_TEXTURE_COUNT > 8
+uniform sampler3D uVolumeTex8;
+#endif
 
 float volumeIor(vec3 uvw) {
 #ifdef HAS_IOR
@@ -114,5 +117,14 @@ vec4 volumeReflect(vec3 uvw) {
   return texture(REFLECT_SAMPLER, uvw).REFLECT_SWZ;
 #else
   return vec4(0.0);
+#endif
+}
+
+// The signed distances of the interface slots (core/interfaces.h): negative inside; +band far out.
+vec4 volumeInterfaces(vec3 uvw) {
+#ifdef HAS_INTERFACES
+  return texture(INTERFACES_SAMPLER, uvw).INTERFACES_SWZ;
+#else
+  return vec4(1e30);
 #endif
 }

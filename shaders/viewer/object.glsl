@@ -14,6 +14,9 @@
 // file: a short loop over the named steps defined above it, in the order it calls them.
 
 uniform sampler3D uO@Bricks;  // homogeneousBricks (viewer/volume_analysis.h), nearest filtering
+#ifdef HAS_RECEIVER
+uniform sampler2D uO@Receiver;  // the receiver map of the ground (core/receiver_map.h), RGB W/m²
+#endif
 
 // The state of a ray inside this object, in the volume's own space.
 struct March@ {
@@ -41,6 +44,7 @@ struct March@ {
   vec3 groundPoint, groundNormal;
   float side;       // height above the ground at the last sample
   vec3 xPrev;       // position at the last sample
+  int medium;       // sharp interfaces (HAS_INTERFACES): the material slot the ray is in, −1 air
 };
 
 // Radiance of an opaque embedding of diffuse albedo ρ at uvw: ρE/π with the baked irradiance E
@@ -75,10 +79,51 @@ float bakedGroundIrradiance@(vec3 xw, out vec3 E) {
 }
 #endif
 
+// The change this object's bake makes to the ground's planar irradiance at world point xw: its
+// receiver map there minus the direct light it was baked with (its shadow, its caustic, what it
+// reflects onto the ground). False where the map does not reach (GROUND, HAS_RECEIVER).
+#ifdef GROUND
+bool receiverChange@(vec3 xw, out vec3 change) {
+  change = vec3(0.0);
+#ifdef HAS_RECEIVER
+  vec3 x = (uObjWorldToVol[@] * vec4(xw, 1.0)).xyz;
+  vec3 q = x - uObjRecvPoint[@];
+  vec2 st = (vec2(dot(q, uObjRecvU[@]), dot(q, uObjRecvV[@])) - uObjRecvOrigin[@]) / uObjRecvSize[@];
+  if (any(lessThan(st, vec2(0.0))) || any(greaterThan(st, vec2(1.0)))) return false;
+  vec3 normal = cross(uObjRecvU[@], uObjRecvV[@]);
+  change = texture(uO@Receiver, st).rgb - lightIrradiance(uObjRecvLightPos[@], uObjRecvLightPower[@], x, normal);
+  return true;
+#else
+  return false;
+#endif
+}
+#endif
+
+// Sharp interfaces (HAS_INTERFACES; core/interfaces.h, docs/physics.md): the material at a point
+// is the first slot whose distance is negative. Its n is the slot's constant (SLOT_IOR, with the
+// Cauchy term of its SLOT_DISPERSION) or, in a graded slot, the ior field.
+int materialAt@(vec4 d) {
+#ifdef HAS_INTERFACES
+  for (int k = 0; k < INTERFACE_SLOTS; ++k)
+    if (d[k] < 0.0) return k;
+#endif
+  return -1;
+}
+
 // n and ∇n at uvw for the wavelength whose Cauchy term (1/λ² − 1/λ_d²) is `cauchy` (thesis
 // §3.2.7, docs/volume-format.md): n(λ) = n + B·cauchy; ∇n scales with n − 1 (B ∝ n − 1 within one
 // material). ior and ior_grad share one RGBA texture (SceneRenderer checks): one fetch for both.
-vec4 refractiveIndex@(vec3 uvw, float cauchy) {
+vec4 refractiveIndex@(vec3 uvw, float cauchy, int medium) {
+#ifdef HAS_INTERFACES
+  if (medium < 0) return vec4(1.0, 0.0, 0.0, 0.0);
+  if (SLOT_GRADED[medium] < 0.5) {
+#ifdef DISPERSION
+    return vec4(SLOT_IOR[medium] + SLOT_DISPERSION[medium] * cauchy, 0.0, 0.0, 0.0);
+#else
+    return vec4(SLOT_IOR[medium], 0.0, 0.0, 0.0);
+#endif
+  }
+#endif
   vec4 optics = texture(IOR_SAMPLER, uvw);  // ior (r), ior_grad (gba)
 #if defined(DISPERSION) && defined(HAS_DISPERSION)
   float B = volumeDispersion(uvw);
@@ -136,7 +181,8 @@ March@ enterVolume@(Ray r, float cauchy) {
   m.h = uObjStep[@];
   vec3 d = normalize(mat3(toVolume) * r.d);
   m.x = (toVolume * vec4(r.x, 1.0)).xyz + d * (1e-3 * m.h);
-  vec4 optics = refractiveIndex@((m.x - m.bmin) * m.invExtent, cauchy);
+  m.medium = materialAt@(volumeInterfaces((m.x - m.bmin) * m.invExtent));
+  vec4 optics = refractiveIndex@((m.x - m.bmin) * m.invExtent, cauchy, m.medium);
   m.n = optics.r;
   m.w = d * m.n;
   m.tau = vec3(0.0);
@@ -286,6 +332,9 @@ bool hitOpaque@(inout Ray r, inout March@ m, vec3 uvw) {
 // (crossBoundary). Elsewhere |w| = n holds by itself (w changes only where ∇n ≠ 0), so the steps
 // do not renormalise (llvmpipe: it was half the cost of a step).
 void followBoundaryLayer@(inout Ray r, inout March@ m, vec3 grad, float grad2, bool quiet, vec3 uvw) {
+#ifdef HAS_INTERFACES
+  return;  // n is sharp: crossInterface does what a smoothed layer does here
+#endif
   if (!m.inLayer && quiet) rememberStateBeforeLayer@(m, m.n, normalize(m.w));
   if (m.inLayer ? !quiet : grad2 > m.threshold2) {
     if (!m.inLayer || grad2 > m.gradPeak2) {
@@ -331,6 +380,20 @@ void inScatter@(inout Ray r, March@ m, vec3 uvw, float hs) {
 #endif
 }
 
+// The step: far from any boundary (|∇n| under a 16th of the boundary threshold) it doubles; the
+// next boundary layer is still resolved, and the renormalisation across ∇n keeps the direction
+// after it exact (Snell's law in a layered medium). With sharp interfaces it doubles only more
+// than two voxels from every surface, so that no thin wall is stepped over.
+float stepLength@(March@ m, vec3 uvw, float grad2) {
+  bool quiet = grad2 <= m.quiet2;
+#ifdef HAS_INTERFACES
+  vec4 d = abs(volumeInterfaces(uvw));
+  float nearest = min(min(d.x, d.y), min(d.z, d.w));
+  quiet = quiet && nearest > 4.0 * m.h;
+#endif
+  return quiet ? 2.0 * m.h : m.h;
+}
+
 // What the medium does over the step hs: one term of the sum of Eq. 5.10 with
 // L_c = ω̂·L_s + L_e (Eq. 5.4; δ·R·L_r comes at the boundaries), and its attenuation.
 void gatherMedium@(inout Ray r, inout March@ m, vec3 uvw, float hs) {
@@ -346,11 +409,11 @@ void stepRay@(inout March@ m, vec3 grad, float hs, float cauchy) {
   m.xStepStart = m.x;
 #ifdef RK4
   vec3 k1x = m.w / m.n, k1w = grad;
-  vec4 o2 = refractiveIndex@((m.x + 0.5 * hs * k1x - m.bmin) * m.invExtent, cauchy);
+  vec4 o2 = refractiveIndex@((m.x + 0.5 * hs * k1x - m.bmin) * m.invExtent, cauchy, m.medium);
   vec3 k2x = (m.w + 0.5 * hs * k1w) / o2.r, k2w = o2.gba;
-  vec4 o3 = refractiveIndex@((m.x + 0.5 * hs * k2x - m.bmin) * m.invExtent, cauchy);
+  vec4 o3 = refractiveIndex@((m.x + 0.5 * hs * k2x - m.bmin) * m.invExtent, cauchy, m.medium);
   vec3 k3x = (m.w + 0.5 * hs * k2w) / o3.r, k3w = o3.gba;
-  vec4 o4 = refractiveIndex@((m.x + hs * k3x - m.bmin) * m.invExtent, cauchy);
+  vec4 o4 = refractiveIndex@((m.x + hs * k3x - m.bmin) * m.invExtent, cauchy, m.medium);
   vec3 k4x = (m.w + hs * k3w) / o4.r, k4w = o4.gba;
   m.x += hs / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
   m.w += hs / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
@@ -358,6 +421,86 @@ void stepRay@(inout March@ m, vec3 grad, float hs, float cauchy) {
   m.x += hs * (m.w + 0.5 * hs * grad) / m.n;  // Eq. 5.11, w at mid-step
   m.w += hs * grad;                            // Eq. 5.12
 #endif
+}
+
+// A sharp interface crossed by the last step (HAS_INTERFACES): the step's chord from xStepStart
+// to x is cut where the first slot distance that changed sign is zero (linear interpolation, one
+// regula falsi refinement), and there, with the normal ∇d of that slot and n on both sides:
+// into an opaque material the ray stops and sees its surface (ρE/π); past the critical angle it
+// reflects totally; else Snell's law bends it and the exact Fresnel R (corrected Eq. 3.6) sends
+// R of it to the reflected direction (the environment, seen from outside the denser medium, as
+// crossBoundary) and keeps 1 − R. The ray goes on from the interface. True when the ray stopped.
+bool crossInterface@(inout Ray r, inout March@ m, float cauchy) {
+#ifdef HAS_INTERFACES
+  vec3 x0 = m.xStepStart, x1 = m.x;
+  vec4 d0 = volumeInterfaces((x0 - m.bmin) * m.invExtent);
+  vec4 d1 = volumeInterfaces((x1 - m.bmin) * m.invExtent);
+  int next = materialAt@(d1);
+  if (next == m.medium) return false;
+  float best = 2.0;
+  int slot = -1;
+  for (int k = 0; k < INTERFACE_SLOTS; ++k) {
+    if ((d0[k] < 0.0) == (d1[k] < 0.0)) continue;
+    float f = d0[k] / (d0[k] - d1[k]);
+    float g = volumeInterfaces((mix(x0, x1, f) - m.bmin) * m.invExtent)[k];
+    f = (g < 0.0) == (d0[k] < 0.0) ? f + (1.0 - f) * g / (g - d1[k]) : f * d0[k] / (d0[k] - g);
+    if (f < best) { best = f; slot = k; }
+  }
+  if (slot < 0) {  // on a surface already (the medium disagrees with d0): the crossing is at x0
+    best = 0.0;
+    slot = m.medium >= 0 ? m.medium : next;
+  }
+  vec3 p = mix(x0, x1, best);
+  vec4 dp = volumeInterfaces((p - m.bmin) * m.invExtent);
+  dp[slot] = (d0[slot] < 0.0) ? 1.0 : -1.0;  // just past the surface
+  int entered = materialAt@(dp);
+  m.x = p;
+  if (entered == m.medium) return false;
+  vec3 e = 0.5 / m.invExtent / vec3(textureSize(INTERFACES_SAMPLER, 0));  // half a voxel
+  vec3 normal = vec3(
+      volumeInterfaces((p + vec3(e.x, 0, 0) - m.bmin) * m.invExtent)[slot] - volumeInterfaces((p - vec3(e.x, 0, 0) - m.bmin) * m.invExtent)[slot],
+      volumeInterfaces((p + vec3(0, e.y, 0) - m.bmin) * m.invExtent)[slot] - volumeInterfaces((p - vec3(0, e.y, 0) - m.bmin) * m.invExtent)[slot],
+      volumeInterfaces((p + vec3(0, 0, e.z) - m.bmin) * m.invExtent)[slot] - volumeInterfaces((p - vec3(0, 0, e.z) - m.bmin) * m.invExtent)[slot]) / e;
+  vec3 uvw = (p - m.bmin) * m.invExtent;
+  if (entered >= 0 && SLOT_OPAQUE[entered] > 0.5) {
+    vec4 opaque = volumeOpaque(uvw);
+    vec3 albedo = opaque.a > 0.0 ? opaque.rgb / opaque.a : vec3(0.8);
+    r.radiance += r.T * exp(-m.tau) * opaqueRadiance@(albedo, uvw);
+    r.x = (uObjVolToWorld[@] * vec4(p, 1.0)).xyz;
+    r.done = true;
+    m.stopped = true;
+    return true;
+  }
+  if (dot(normal, normal) == 0.0) {
+    m.medium = entered;
+    m.n = refractiveIndex@(uvw, cauchy, entered).r;
+    m.w = normalize(m.w) * m.n;
+    return false;
+  }
+  normal = normalize(normal);
+  float n1 = refractiveIndex@(uvw, cauchy, m.medium).r, n2 = refractiveIndex@(uvw, cauchy, entered).r;
+  vec3 d = normalize(m.w);
+  vec3 facing = dot(d, normal) < 0.0 ? normal : -normal;
+  float cosI = min(1.0, -dot(d, facing));
+  float sin2T = snellSinT2(n1, n2, cosI);
+  if (sin2T >= 1.0) {  // total internal reflection
+    m.w = reflect(d, facing) * n1;
+    m.n = n1;
+    return false;
+  }
+#ifdef FRESNEL
+  float R = fresnelUnpolarised(n1, n2, cosI, sqrt(1.0 - sin2T));
+  if (n2 > n1) {
+    vec3 reflected = normalize(mat3(uObjVolToWorld[@]) * reflect(d, facing));
+    r.radiance += r.T * exp(-m.tau) * R * environmentRadiance(reflected, uReflectionLod);
+  }
+  r.T *= 1.0 - R;
+#endif
+  m.w = refract(d, facing, n1 / n2) * n2;
+  m.n = n2;
+  m.medium = entered;
+#endif
+  return false;
 }
 
 // Early termination (not inside a boundary layer, whose reflection is still to come): every
@@ -401,19 +544,16 @@ void march@(inout Ray r, float cauchy) {
     }
     vec3 uvw = (m.x - m.bmin) * m.invExtent;
     if (skipHomogeneousBrick@(m, uvw)) continue;
-    vec4 optics = refractiveIndex@(uvw, cauchy);
+    vec4 optics = refractiveIndex@(uvw, cauchy, m.medium);
     m.n = optics.r;
     vec3 grad = optics.gba;
-    // Far from any boundary (|∇n| under a 16th of the boundary threshold) the step doubles: the
-    // next boundary layer is still resolved, and the renormalisation across ∇n keeps the direction
-    // after it exact (Snell's law in a layered medium).
     float grad2 = dot(grad, grad);
-    bool quiet = grad2 <= m.quiet2;
-    float hs = quiet ? 2.0 * m.h : m.h;
+    float hs = stepLength@(m, uvw, grad2);
     if (hitOpaque@(r, m, uvw)) break;
-    followBoundaryLayer@(r, m, grad, grad2, quiet, uvw);
+    followBoundaryLayer@(r, m, grad, grad2, grad2 <= m.quiet2, uvw);
     gatherMedium@(r, m, uvw, hs);
     stepRay@(m, grad, hs, cauchy);
+    if (crossInterface@(r, m, cauchy)) break;
     if (absorbed@(r, m)) break;
   }
   leaveVolume@(r, m);

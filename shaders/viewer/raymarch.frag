@@ -33,6 +33,16 @@ uniform float uObjStep[OBJECT_COUNT];        // arc length per step, volume unit
 uniform int uObjMaxSteps[OBJECT_COUNT];
 uniform float uObjBoundaryGrad[OBJECT_COUNT];  // |∇n| above which the ray is in a boundary layer
 uniform vec3 uObjBrickSize[OBJECT_COUNT];    // a homogeneity brick's extent, volume units
+// The object's receiver map of the ground (HAS_RECEIVER; core/receiver_map.h), volume space: the
+// plane's point and in-plane axes, the map's corner (u, v) and extent, and the light it was baked
+// with (w = 0: direction it travels, w = 1: position; its irradiance or intensity).
+uniform vec3 uObjRecvPoint[OBJECT_COUNT];
+uniform vec3 uObjRecvU[OBJECT_COUNT];
+uniform vec3 uObjRecvV[OBJECT_COUNT];
+uniform vec2 uObjRecvOrigin[OBJECT_COUNT];
+uniform vec2 uObjRecvSize[OBJECT_COUNT];
+uniform vec4 uObjRecvLightPos[OBJECT_COUNT];
+uniform vec3 uObjRecvLightPower[OBJECT_COUNT];
 
 uniform float uMinTransmittance;  // early termination
 uniform float uMaxOpticalDepth;   // −ln(uMinTransmittance)
@@ -70,18 +80,19 @@ struct Ray {
 };
 
 // Irradiance from the scene's lights at x on a surface of normal N, nothing in the way.
+// Planar irradiance at x on a surface of normal N from one light (w = 0: directional, its
+// irradiance; w = 1: point, its intensity), unoccluded: E·cos θ, or I·cos θ/r².
+vec3 lightIrradiance(vec4 pos, vec3 power, vec3 x, vec3 N) {
+  if (pos.w == 0.0) return power * max(0.0, -dot(N, pos.xyz));
+  vec3 L = pos.xyz - x;
+  float r2 = max(dot(L, L), 1e-12);
+  return power * max(0.0, dot(N, L) * inversesqrt(r2)) / r2;
+}
+
 vec3 unoccludedIrradiance(vec3 x, vec3 N) {
   vec3 E = vec3(0.0);
 #if LIGHT_COUNT > 0
-  for (int i = 0; i < LIGHT_COUNT; ++i) {
-    if (uLightPos[i].w == 0.0) {
-      E += uLightPower[i] * max(0.0, -dot(N, uLightPos[i].xyz));
-    } else {
-      vec3 L = uLightPos[i].xyz - x;
-      float r2 = max(dot(L, L), 1e-12);
-      E += uLightPower[i] * max(0.0, dot(N, L) * inversesqrt(r2)) / r2;
-    }
-  }
+  for (int i = 0; i < LIGHT_COUNT; ++i) E += lightIrradiance(uLightPos[i], uLightPower[i], x, N);
 #endif
   return E;
 }
@@ -124,14 +135,22 @@ float bakedGroundIrradiance(vec3 xw, out vec3 E) {
   return 0.0;
 }
 
-// Lambertian ground: ρE/π with the baked irradiance where it lies inside a baked volume (caustics,
-// shadows), the scene's lights unoccluded elsewhere (docs/physics.md "Receivers"), plus the environment.
+// Lambertian ground: ρE/π (docs/physics.md "Receivers"), plus the environment. E is the scene's
+// lights unoccluded, changed by every object whose receiver map covers the point (its map minus
+// the direct light it was baked with: its shadow, its caustic, the light it reflects there). A
+// volume without a receiver map gives its fluence-like baked irradiance where the ground lies in
+// its box (the first release's approximation).
 vec3 groundRadiance(vec3 xw) {
-  vec3 baked;
-  float weight = bakedGroundIrradiance(xw, baked);
-  vec3 E = weight > 0.0 ? mix(unoccludedIrradiance(xw, uGroundNormal), baked, weight)
-                        : unoccludedIrradiance(xw, uGroundNormal);
-  return uGroundAlbedo * E * INV_PI + uGroundAmbient;
+  vec3 E = unoccludedIrradiance(xw, uGroundNormal);
+  bool mapped = false;
+  vec3 change;
+  if (receiverChange@(xw, change)) { E += change; mapped = true; }  // @EACH_OBJECT@
+  if (!mapped) {
+    vec3 baked;
+    float weight = bakedGroundIrradiance(xw, baked);
+    if (weight > 0.0) E = mix(E, baked, weight);
+  }
+  return uGroundAlbedo * max(E, vec3(0.0)) * INV_PI + uGroundAmbient;
 }
 #endif
 

@@ -1,0 +1,88 @@
+#include "core/interfaces.h"
+
+#include <cmath>
+
+#include "core/error.h"
+
+namespace eik {
+
+nlohmann::json InterfaceTable::toJson() const {
+  nlohmann::json slots_json = nlohmann::json::array();
+  for (const InterfaceSlot& s : slots)
+    slots_json.push_back({{"name", s.name},
+                          {"ior", s.ior},
+                          {"dispersion_b", s.dispersion_b},
+                          {"graded", s.graded},
+                          {"opaque", s.opaque}});
+  return {{"band", band}, {"slots", slots_json}};
+}
+
+namespace {
+
+double finiteNumber(const nlohmann::json& j, const std::string& source, const std::string& key) {
+  if (!j.is_number()) throw InputError(source, key, "expected a number");
+  const double v = j.get<double>();
+  if (!std::isfinite(v)) throw InputError(source, key, "must be finite");
+  return v;
+}
+
+bool boolean(const nlohmann::json& j, const std::string& source, const std::string& key) {
+  if (!j.is_boolean()) throw InputError(source, key, "expected true or false");
+  return j.get<bool>();
+}
+
+}  // namespace
+
+InterfaceTable interfaceTable(const Volume& volume, const std::string& source) {
+  InterfaceTable table;
+  const bool has_field = volume.has("interfaces");
+  const bool has_table = volume.metadata.is_object() && volume.metadata.contains("interfaces");
+  if (!has_field && !has_table) return table;
+  if (has_field && !has_table)
+    throw InputError(source, "interfaces", "the volume has an interfaces field but no interfaces table");
+  if (!has_field) throw InputError(source, "fields.interfaces", "the manifest lists interfaces but has no such field");
+  volume.require("interfaces", 4, source);
+  const nlohmann::json& j = volume.metadata.at("interfaces");
+  if (!j.is_object()) throw InputError(source, "interfaces", "expected an object");
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (it.key() != "band" && it.key() != "slots")
+      throw InputError(source, "interfaces." + it.key(), "unknown key (expected one of: band, slots)");
+  if (!j.contains("band")) throw InputError(source, "interfaces.band", "missing");
+  table.band = finiteNumber(j.at("band"), source, "interfaces.band");
+  if (!(table.band > 0.0)) throw InputError(source, "interfaces.band", "must be positive");
+  if (!j.contains("slots") || !j.at("slots").is_array())
+    throw InputError(source, "interfaces.slots", "expected an array");
+  const nlohmann::json& slots = j.at("slots");
+  if (slots.empty() || slots.size() > static_cast<std::size_t>(kMaxInterfaceSlots))
+    throw InputError(source, "interfaces.slots",
+                     "must hold 1 to " + std::to_string(kMaxInterfaceSlots) + " slots, has " +
+                         std::to_string(slots.size()));
+  for (std::size_t i = 0; i < slots.size(); ++i) {
+    const std::string key = "interfaces.slots[" + std::to_string(i) + "]";
+    const nlohmann::json& s = slots[i];
+    if (!s.is_object()) throw InputError(source, key, "expected an object");
+    InterfaceSlot slot;
+    for (auto it = s.begin(); it != s.end(); ++it) {
+      const std::string k = it.key(), field = key + "." + k;
+      if (k == "name") {
+        if (!it->is_string()) throw InputError(source, field, "expected a string");
+        slot.name = it->get<std::string>();
+      } else if (k == "ior") {
+        slot.ior = finiteNumber(*it, source, field);
+        if (!(slot.ior >= 1.0 && slot.ior <= 10.0)) throw InputError(source, field, "must be in [1, 10]");
+      } else if (k == "dispersion_b") {
+        slot.dispersion_b = finiteNumber(*it, source, field);
+      } else if (k == "graded") {
+        slot.graded = boolean(*it, source, field);
+      } else if (k == "opaque") {
+        slot.opaque = boolean(*it, source, field);
+      } else {
+        throw InputError(source, field, "unknown key (expected one of: dispersion_b, graded, ior, name, opaque)");
+      }
+    }
+    table.slots.push_back(slot);
+  }
+  return table;
+}
+
+}  // namespace eik

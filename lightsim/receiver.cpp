@@ -1,0 +1,154 @@
+#include "lightsim/receiver.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/error.h"
+#include "lightsim/wavefront.h"
+
+namespace eik {
+
+ReceiverMap receiverGeometry(const ReceiverSpec& spec, const LightSpec& light, const GridSpec& grid,
+                             const glm::dvec3& box_lo, const glm::dvec3& box_hi) {
+  ReceiverMap map;
+  map.name = spec.name;
+  map.point = spec.point;
+  map.normal = glm::normalize(spec.normal);
+  receiverAxes(map.normal, map.u, map.v);
+  // The box's corners seen from the light, on the plane.
+  glm::dvec2 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+  for (int k = 0; k < 8; ++k) {
+    const glm::dvec3 corner((k & 1) ? box_hi.x : box_lo.x, (k & 2) ? box_hi.y : box_lo.y, (k & 4) ? box_hi.z : box_lo.z);
+    glm::dvec3 dir = light.type == LightSpec::Type::Directional ? glm::normalize(light.direction)
+                                                                : corner - light.position;
+    const double facing = glm::dot(dir, map.normal);
+    if (!(facing < 0.0))
+      throw InputError("receiver", spec.name,
+                       "the light does not reach the plane from its front side (the plane's normal must face the light)");
+    const double height = glm::dot(corner - map.point, map.normal);
+    // Corners below the plane project back up along the light; either way onto the plane.
+    const glm::dvec3 on_plane = corner - (height / facing) * dir;
+    const glm::dvec2 uv = map.planeCoordinates(on_plane);
+    lo = glm::min(lo, uv);
+    hi = glm::max(hi, uv);
+  }
+  if (spec.half_extent < 1e29) {
+    // A bounded plane is mapped whole: light the object reflects or bends lands beyond its shadow.
+    lo = glm::dvec2(-spec.half_extent);
+    hi = glm::dvec2(spec.half_extent);
+  }
+  if (!(lo.x < hi.x && lo.y < hi.y))
+    throw InputError("receiver", spec.name, "the volume's box does not shade any part of the plane's square");
+  map.pitch = spec.pitch_voxels * voxelEdge(grid);
+  const double longest = std::max(hi.x - lo.x, hi.y - lo.y);
+  if (longest / map.pitch > kMaxReceiverTexels) map.pitch = longest / kMaxReceiverTexels;
+  map.texels = glm::ivec2(static_cast<int>(std::ceil((hi.x - lo.x) / map.pitch - 1e-9)),
+                          static_cast<int>(std::ceil((hi.y - lo.y) / map.pitch - 1e-9)));
+  map.texels = glm::max(map.texels, glm::ivec2(1));
+  map.origin = lo;
+  return map;
+}
+
+bool patchFootprint(const Patch& patch, const ReceiverMap& map, std::array<glm::dvec2, 4>& footprint) {
+  for (int c = 0; c < 4; ++c) {
+    const glm::dvec3 d = patch.w[c];
+    const double facing = glm::dot(d, map.normal);
+    if (facing == 0.0) return false;
+    const double height = glm::dot(patch.x[c] - map.point, map.normal);
+    footprint[static_cast<std::size_t>(c)] = map.planeCoordinates(patch.x[c] - (height / facing) * d);
+  }
+  return true;
+}
+
+namespace {
+
+double cross2(const glm::dvec2& a, const glm::dvec2& b) { return a.x * b.y - a.y * b.x; }
+
+// Clips a convex polygon (at most 7 vertices after 4 half-planes of a triangle) against the
+// half-plane `sign·(p[axis] − bound) ≤ 0`.
+int clipAgainst(const glm::dvec2* in, int count, glm::dvec2* out, int axis, double bound, double sign) {
+  int n = 0;
+  for (int i = 0; i < count; ++i) {
+    const glm::dvec2 a = in[i], b = in[(i + 1) % count];
+    const double da = sign * (a[axis] - bound), db = sign * (b[axis] - bound);
+    if (da <= 0.0) out[n++] = a;
+    if ((da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0)) out[n++] = a + (da / (da - db)) * (b - a);
+  }
+  return n;
+}
+
+double polygonArea(const glm::dvec2* p, int count) {
+  double twice = 0.0;
+  for (int i = 0; i < count; ++i) twice += cross2(p[i], p[(i + 1) % count]);
+  return 0.5 * std::abs(twice);
+}
+
+void depositTriangle(const ReceiverMap& map, const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c,
+                     const glm::dvec3& flux, std::vector<glm::dvec3>& texel_flux) {
+  const double area = 0.5 * std::abs(cross2(b - a, c - a));
+  if (!(area > 0.0)) {
+    // A degenerate footprint (all corners on a line or a point): its flux goes to the texel of its centre.
+    const glm::dvec2 t = ((a + b + c) / 3.0 - map.origin) / map.pitch;
+    const int i = static_cast<int>(std::floor(t.x)), j = static_cast<int>(std::floor(t.y));
+    if (i >= 0 && j >= 0 && i < map.texels.x && j < map.texels.y)
+      texel_flux[static_cast<std::size_t>(j) * static_cast<std::size_t>(map.texels.x) + static_cast<std::size_t>(i)] += flux;
+    return;
+  }
+  const glm::dvec2 lo = (glm::min(a, glm::min(b, c)) - map.origin) / map.pitch;
+  const glm::dvec2 hi = (glm::max(a, glm::max(b, c)) - map.origin) / map.pitch;
+  const int i0 = std::max(0, static_cast<int>(std::floor(lo.x))), j0 = std::max(0, static_cast<int>(std::floor(lo.y)));
+  const int i1 = std::min(map.texels.x - 1, static_cast<int>(std::floor(hi.x)));
+  const int j1 = std::min(map.texels.y - 1, static_cast<int>(std::floor(hi.y)));
+  const glm::dvec3 density = flux / area;
+  // Edge functions, positive inside (whatever the winding): a texel with its four corners inside
+  // all three is covered whole, one with its four corners outside one of them not at all; only the
+  // texels an edge passes through are clipped.
+  const double orient = cross2(b - a, c - a) > 0.0 ? 1.0 : -1.0;
+  const glm::dvec2 p0[3] = {a, b, c}, p1[3] = {b, c, a};
+  auto edge = [&](int e, const glm::dvec2& q) { return orient * cross2(p1[e] - p0[e], q - p0[e]); };
+  const double texel_area = map.pitch * map.pitch;
+  for (int j = j0; j <= j1; ++j)
+    for (int i = i0; i <= i1; ++i) {
+      const glm::dvec2 tlo = map.origin + glm::dvec2(i, j) * map.pitch;
+      const glm::dvec2 corners[4] = {tlo, tlo + glm::dvec2(map.pitch, 0.0), tlo + glm::dvec2(0.0, map.pitch),
+                                     tlo + glm::dvec2(map.pitch)};
+      bool all_inside = true, outside_one = false;
+      for (int e = 0; e < 3 && !outside_one; ++e) {
+        int inside = 0;
+        for (const glm::dvec2& q : corners) inside += edge(e, q) >= 0.0 ? 1 : 0;
+        if (inside != 4) all_inside = false;
+        if (inside == 0) outside_one = true;
+      }
+      if (outside_one) continue;
+      const double overlap = all_inside ? texel_area : triangleSquareOverlap(a, b, c, tlo, tlo + glm::dvec2(map.pitch));
+      if (overlap > 0.0)
+        texel_flux[static_cast<std::size_t>(j) * static_cast<std::size_t>(map.texels.x) + static_cast<std::size_t>(i)] +=
+            density * overlap;
+    }
+}
+
+}  // namespace
+
+double triangleSquareOverlap(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c, const glm::dvec2& lo,
+                             const glm::dvec2& hi) {
+  glm::dvec2 buffer_a[8] = {a, b, c}, buffer_b[8];
+  int n = 3;
+  n = clipAgainst(buffer_a, n, buffer_b, 0, lo.x, -1.0);
+  n = clipAgainst(buffer_b, n, buffer_a, 0, hi.x, 1.0);
+  n = clipAgainst(buffer_a, n, buffer_b, 1, lo.y, -1.0);
+  n = clipAgainst(buffer_b, n, buffer_a, 1, hi.y, 1.0);
+  return n >= 3 ? polygonArea(buffer_a, n) : 0.0;
+}
+
+void depositFootprint(const ReceiverMap& map, const std::array<glm::dvec2, 4>& f, const glm::dvec3& flux,
+                      std::vector<glm::dvec3>& texel_flux) {
+  const double a1 = 0.5 * std::abs(cross2(f[1] - f[0], f[2] - f[0]));
+  const double a2 = 0.5 * std::abs(cross2(f[2] - f[0], f[3] - f[0]));
+  const double total = a1 + a2;
+  const double share = total > 0.0 ? a1 / total : 0.5;
+  depositTriangle(map, f[0], f[1], f[2], flux * share, texel_flux);
+  depositTriangle(map, f[0], f[2], f[3], flux * (1.0 - share), texel_flux);
+}
+
+}  // namespace eik

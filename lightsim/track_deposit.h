@@ -1,0 +1,97 @@
+// Track-length deposits with a trilinear (cloud-in-cell) kernel: ALGORITHM.md step 4.
+//
+// A patch-step deposits its flux times the path length it travels, divided by the voxel volume,
+// spread over the voxels its footprint covers. Each voxel v collects ∫ K_v(x) ds along the paths,
+// where K_v is the trilinear hat of voxel v (1 at its centre, 0 at its neighbours' centres). The
+// hats sum to 1 everywhere, so no flux is lost or gained, and a uniform beam deposits its exact
+// irradiance in every voxel however the patches and steps fall on the grid:
+//  - along a path the integral is exact: the path is cut where it crosses a plane through voxel
+//    centres (where the hats have kinks), and on each piece the weights are cubic polynomials of
+//    the arc length, which 2-point Gauss–Legendre integrates exactly;
+//  - across the patch, sub-paths on a lattice of at most half a voxel (trackLattice) sample the
+//    footprint; with the hat's spectrum (sinc² per axis) the lattice leaves < 0.5 % ripple in a
+//    plane wave at any angle (measured: 0.45 % at worst, 45°, 32³; 0 along the axes).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+
+#include <glm/glm.hpp>
+
+namespace eik {
+
+// The 8 voxels of the trilinear hats that are non-zero at `p` (continuous voxel coordinates,
+// voxel centres at integer + ½) and their weights (summing to 1). Voxels outside [0, dims) are
+// reported with index −1 and must be skipped by the caller (their share belongs to no voxel).
+struct HatWeights {
+  std::array<long long, 8> index;
+  std::array<double, 8> weight;
+};
+
+inline HatWeights hatWeights(const glm::dvec3& p, const glm::ivec3& dims) {
+  const glm::dvec3 f = p - 0.5;
+  const glm::dvec3 base = glm::floor(f);
+  const glm::dvec3 t = f - base;
+  const glm::ivec3 i0(base);
+  HatWeights hw;
+  for (int k = 0; k < 8; ++k) {
+    const glm::ivec3 o(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+    const glm::ivec3 v = i0 + o;
+    const double w = (o.x ? t.x : 1.0 - t.x) * (o.y ? t.y : 1.0 - t.y) * (o.z ? t.z : 1.0 - t.z);
+    const bool inside = v.x >= 0 && v.y >= 0 && v.z >= 0 && v.x < dims.x && v.y < dims.y && v.z < dims.z;
+    hw.index[static_cast<std::size_t>(k)] =
+        inside ? static_cast<long long>(v.x) + static_cast<long long>(dims.x) *
+                                                   (static_cast<long long>(v.y) + static_cast<long long>(dims.y) * v.z)
+               : -1;
+    hw.weight[static_cast<std::size_t>(k)] = w;
+  }
+  return hw;
+}
+
+// Calls visit(voxel_index, weight) for the hats along the segment a → b (continuous voxel
+// coordinates): the weights are ∫ K_v ds / |b − a|, exactly, and sum to 1 over all voxels (those
+// outside the grid are not visited). A voxel may be visited more than once.
+template <typename Visit>
+void forEachTrackWeight(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec3& dims, Visit&& visit) {
+  // Parameters in (0, 1) where the segment crosses a plane through voxel centres: at most
+  // 3 + Σ|b − a| of them.
+  constexpr int kMaxBreaks = 64;
+  std::array<double, kMaxBreaks + 2> breaks;
+  int count = 0;
+  breaks[count++] = 0.0;
+  const glm::dvec3 delta = b - a;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (delta[axis] == 0.0) continue;
+    const double s0 = a[axis] - 0.5, s1 = b[axis] - 0.5;
+    const double lo = std::min(s0, s1), hi = std::max(s0, s1);
+    for (double k = std::floor(lo) + 1.0; k < hi && count <= kMaxBreaks; k += 1.0)
+      breaks[static_cast<std::size_t>(count++)] = (k - s0) / (s1 - s0);
+  }
+  breaks[static_cast<std::size_t>(count++)] = 1.0;
+  std::sort(breaks.begin() + 1, breaks.begin() + count - 1);
+  constexpr double kGauss = 0.28867513459481288225;  // 1/(2√3): the 2-point nodes at ½ ± this
+  for (int piece = 0; piece + 1 < count; ++piece) {
+    const double t0 = breaks[static_cast<std::size_t>(piece)], t1 = breaks[static_cast<std::size_t>(piece + 1)];
+    const double length = t1 - t0;
+    if (!(length > 0.0)) continue;
+    for (const double node : {0.5 - kGauss, 0.5 + kGauss}) {
+      const HatWeights hw = hatWeights(a + (t0 + node * length) * delta, dims);
+      for (std::size_t k = 0; k < 8; ++k)
+        if (hw.index[k] >= 0 && hw.weight[k] != 0.0) visit(hw.index[k], 0.5 * length * hw.weight[k]);
+    }
+  }
+}
+
+// Sub-paths across a patch along one of its parameter directions: n = ceil(edge / ½ voxel) of them
+// (at least 1, at most kMaxTrackLattice), at the centres of n equal parameter intervals, so that
+// neighbouring sub-paths are at most half a voxel apart. `edge_voxels` is the longer of the two
+// patch edges along that direction, in voxels.
+constexpr int kMaxTrackLattice = 16;
+inline int trackLattice(double edge_voxels) {
+  if (!(edge_voxels > 0.5)) return 1;
+  return std::min(kMaxTrackLattice, static_cast<int>(std::ceil(edge_voxels / 0.5 - 1e-9)));
+}
+
+}  // namespace eik
