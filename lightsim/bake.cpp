@@ -46,6 +46,15 @@ nlohmann::json LightSpec::toJson() const {
   return {{"type", "point"}, {"position", vec3Json(position)}, {"intensity", vec3Json(power)}};
 }
 
+double SimulationStats::ledgerResidual() const {
+  const glm::dvec3 accounted =
+      flux_out + flux_absorbed + flux_reflected + flux_killed + flux_unfinished + flux_received + flux_blocked;
+  const double scale = std::max(std::fabs(flux_in.x), std::max(std::fabs(flux_in.y), std::fabs(flux_in.z)));
+  const glm::dvec3 residual = flux_in - accounted;
+  const double worst = std::max(std::fabs(residual.x), std::max(std::fabs(residual.y), std::fabs(residual.z)));
+  return scale > 0.0 ? worst / scale : 0.0;
+}
+
 nlohmann::json SimulationStats::toJson() const {
   nlohmann::json j;
   j["steps"] = steps;
@@ -59,11 +68,6 @@ nlohmann::json SimulationStats::toJson() const {
   j["rollbacks"] = rollbacks;
   // The energy ledger: flux_in = out + absorbed + reflected + killed + unfinished + received +
   // blocked (W, RGB).
-  const glm::dvec3 accounted =
-      flux_out + flux_absorbed + flux_reflected + flux_killed + flux_unfinished + flux_received + flux_blocked;
-  const double scale = std::max(std::fabs(flux_in.x), std::max(std::fabs(flux_in.y), std::fabs(flux_in.z)));
-  const glm::dvec3 residual = flux_in - accounted;
-  const double worst = std::max(std::fabs(residual.x), std::max(std::fabs(residual.y), std::fabs(residual.z)));
   j["flux"] = {{"in", vec3Json(flux_in)},
                {"out", vec3Json(flux_out)},
                {"absorbed", vec3Json(flux_absorbed)},
@@ -72,7 +76,7 @@ nlohmann::json SimulationStats::toJson() const {
                {"unfinished", vec3Json(flux_unfinished)},
                {"received", vec3Json(flux_received)},
                {"blocked", vec3Json(flux_blocked)},
-               {"ledger_relative_residual", scale > 0.0 ? worst / scale : 0.0}};
+               {"ledger_relative_residual", ledgerResidual()}};
   j["phase_seconds"] = nlohmann::json::object();
   for (const auto& [name, seconds] : phase_seconds) j["phase_seconds"][name] = seconds;
   j["backend"] = backend;

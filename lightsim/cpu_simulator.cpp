@@ -210,10 +210,17 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
     // Either the step stretched it far, or it is the patch's first touch of an interface and some
     // corners will not follow (willTear).
     patch.reflections += crossing.reflections;
-    if (crossing.met_interface && patch.depth < options.max_depth && oneMedium(before)) {
+    if (crossing.met_interface && oneMedium(before)) {
       const bool stretched = splitAxes(patch, kTearFactor * threshold, options.split_rule).any();
       const bool first_touch = crossing.met_mask != 0xF;
       const bool tears = stretched || (first_touch && willTear(patch, crossing, sampler, 4.0 * std::max(patch.longestEdge(), h)));
+      if (tears && patch.depth >= options.max_depth) {
+        // Torn at the depth limit: its corners now fan out over both sides of an edge or a
+        // silhouette, and its interior says nothing about where its light goes. It dies here
+        // (its flux counted as killed), before it deposits anything.
+        result.fate = PatchFate::KilledDepth;
+        return result;
+      }
       if (tears) {
         SplitAxes axes = splitAxes(patch, threshold, options.split_rule);
         if (!axes.any()) axes = splitAxes(before, 0.0, options.split_rule);  // a tear ahead: halve it
@@ -403,14 +410,15 @@ namespace {
 // depend on the thread count.
 void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<PatchStepResult>& results,
                         const GridSpec& grid, const ReceiverMap* receiver, std::vector<glm::dvec3>& irradiance,
-                        std::vector<glm::dvec3>& direction) {
+                        std::vector<glm::dvec3>& direction, std::vector<std::vector<std::uint32_t>>& by_slab) {
   const std::size_t count = results.size();
   const glm::dvec3 h = grid.voxelSize();
   const double inv_volume = 1.0 / grid.voxelVolume();
   // Slabs of z-slices, and the patches whose hats reach each one (in patch order).
   const int slab_depth = std::max(1, grid.dims.z / (4 * static_cast<int>(workerThreads())));
   const int slabs = (grid.dims.z + slab_depth - 1) / slab_depth;
-  std::vector<std::vector<std::uint32_t>> by_slab(static_cast<std::size_t>(slabs));
+  by_slab.resize(static_cast<std::size_t>(slabs));
+  for (auto& list : by_slab) list.clear();
   for (std::size_t i = 0; i < count; ++i) {
     const PatchStepResult& r = results[i];
     if (!r.track || r.rolled_back) continue;
@@ -452,7 +460,7 @@ void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<Pat
           const glm::dvec3 dsum = (lum * length) * dir;
           forEachTrackWeight(grid.toVoxel(a), grid.toVoxel(b), grid.dims, [&](long long v, double w) {
             const std::size_t at = static_cast<std::size_t>(v);
-            if (at < lo || at >= hi) return;
+            if (at - lo >= hi - lo) return;  // another slab's voxel (unsigned: also below lo)
             irradiance[at] += e * w;
             direction[at] += dsum * w;
           });
@@ -507,6 +515,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
       [&](std::int64_t i) { samples[static_cast<std::size_t>(i)] = samplePatch(patches[static_cast<std::size_t>(i)], sampler_); },
       256);
   std::vector<PatchStepResult> results;
+  std::vector<std::vector<std::uint32_t>> slab_lists;
   std::vector<std::uint64_t> offsets;
   std::vector<Patch> next;
   std::vector<PatchSamples> next_samples;
@@ -533,7 +542,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
 
     // Deposits and the ledger, in patch order (deterministic sums).
     t.restart();
-    if (track) applyTrackDeposits(patches, results, grid, ctx.receiver, irradiance, direction);
+    if (track) applyTrackDeposits(patches, results, grid, ctx.receiver, irradiance, direction, slab_lists);
     offsets.resize(count + 1);
     std::uint64_t total = 0;
     for (std::size_t i = 0; i < count; ++i) {

@@ -97,8 +97,7 @@ void depositTriangle(const ReceiverMap& map, const glm::dvec2& a, const glm::dve
   }
   const glm::dvec2 lo = (glm::min(a, glm::min(b, c)) - map.origin) / map.pitch;
   const glm::dvec2 hi = (glm::max(a, glm::max(b, c)) - map.origin) / map.pitch;
-  const int i0 = std::max(0, static_cast<int>(std::floor(lo.x))), j0 = std::max(0, static_cast<int>(std::floor(lo.y)));
-  const int i1 = std::min(map.texels.x - 1, static_cast<int>(std::floor(hi.x)));
+  const int j0 = std::max(0, static_cast<int>(std::floor(lo.y)));
   const int j1 = std::min(map.texels.y - 1, static_cast<int>(std::floor(hi.y)));
   const glm::dvec3 density = flux / area;
   // Edge functions, positive inside (whatever the winding): a texel with its four corners inside
@@ -108,7 +107,18 @@ void depositTriangle(const ReceiverMap& map, const glm::dvec2& a, const glm::dve
   const glm::dvec2 p0[3] = {a, b, c}, p1[3] = {b, c, a};
   auto edge = [&](int e, const glm::dvec2& q) { return orient * cross2(p1[e] - p0[e], q - p0[e]); };
   const double texel_area = map.pitch * map.pitch;
-  for (int j = j0; j <= j1; ++j)
+  for (int j = j0; j <= j1; ++j) {
+    // The triangle's extent within this row of texels (clipped to the row), so that a long thin
+    // footprint (light grazing the plane) costs the texels it touches, not its bounding box.
+    const double y0 = map.origin.y + j * map.pitch, y1 = y0 + map.pitch;
+    glm::dvec2 buffer_a[8] = {a, b, c}, buffer_b[8];
+    int n = clipAgainst(buffer_a, 3, buffer_b, 1, y0, -1.0);
+    n = clipAgainst(buffer_b, n, buffer_a, 1, y1, 1.0);
+    if (n < 3) continue;
+    double xmin = buffer_a[0].x, xmax = buffer_a[0].x;
+    for (int k = 1; k < n; ++k) xmin = std::min(xmin, buffer_a[k].x), xmax = std::max(xmax, buffer_a[k].x);
+    const int i0 = std::max(0, static_cast<int>(std::floor((xmin - map.origin.x) / map.pitch)));
+    const int i1 = std::min(map.texels.x - 1, static_cast<int>(std::floor((xmax - map.origin.x) / map.pitch)));
     for (int i = i0; i <= i1; ++i) {
       const glm::dvec2 tlo = map.origin + glm::dvec2(i, j) * map.pitch;
       const glm::dvec2 corners[4] = {tlo, tlo + glm::dvec2(map.pitch, 0.0), tlo + glm::dvec2(0.0, map.pitch),
@@ -126,6 +136,7 @@ void depositTriangle(const ReceiverMap& map, const glm::dvec2& a, const glm::dve
         texel_flux[static_cast<std::size_t>(j) * static_cast<std::size_t>(map.texels.x) + static_cast<std::size_t>(i)] +=
             density * overlap;
     }
+  }
 }
 
 }  // namespace

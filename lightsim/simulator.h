@@ -108,6 +108,9 @@ struct SimulationStats {
   std::uint64_t reflections = 0;     // reflected wavefronts followed (bounces)
   std::uint64_t rollbacks = 0;       // steps undone to split a patch torn by an interface
   std::map<std::string, double> phase_seconds;   // "init", "update", "analysis", "compact", "deposit", "readback", ...
+  // |flux_in − (out + absorbed + reflected + killed + unfinished + received + blocked)| over the
+  // largest channel of flux_in, worst channel: 0 for an exact ledger.
+  double ledgerResidual() const;
   std::string backend;               // "gl" or "cpu"
   std::string renderer;              // GL renderer string or "cpu, N threads"
   nlohmann::json toJson() const;

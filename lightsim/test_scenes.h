@@ -64,6 +64,32 @@ inline Volume proceduralVolume(const std::string& spec_text, int res, std::optio
   return buildVolume(voxelizeProcedural(spec, grid), grid, options);
 }
 
+// The same with sharp interfaces (voxelize --interfaces sharp): per-material signed distances, n
+// unblended and unsmoothed (core/interfaces.h).
+// Several specs make several objects, composited as voxelize does (the innermost wins).
+inline Volume sharpVolume(const std::vector<std::string>& spec_texts, int res,
+                          std::optional<Bounds> bounds = std::nullopt, double pad_voxels = kDefaultPadVoxels) {
+  std::vector<ProceduralSpec> specs;
+  Bounds all;
+  for (const std::string& text : spec_texts) {
+    specs.push_back(parseProceduralSpec(text));
+    all.extend(proceduralBounds(specs.back()));
+  }
+  const GridSpec grid = makeGrid(all, res, pad_voxels, bounds);
+  ProceduralOptions procedural;
+  procedural.distance_band = interfaceBand(grid);
+  std::vector<Region> regions;
+  for (const ProceduralSpec& spec : specs)
+    for (Region& r : voxelizeProcedural(spec, grid, procedural)) regions.push_back(std::move(r));
+  PipelineOptions options;
+  options.interfaces = InterfaceMode::Sharp;
+  return buildVolume(regions, grid, options);
+}
+inline Volume sharpVolume(const std::string& spec_text, int res, std::optional<Bounds> bounds = std::nullopt,
+                          double pad_voxels = kDefaultPadVoxels) {
+  return sharpVolume(std::vector<std::string>{spec_text}, res, bounds, pad_voxels);
+}
+
 // The box [−a, a]³.
 inline Bounds cube(double half) {
   Bounds b;

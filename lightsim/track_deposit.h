@@ -70,7 +70,16 @@ void forEachTrackWeight(const glm::dvec3& a, const glm::dvec3& b, const glm::ive
       breaks[static_cast<std::size_t>(count++)] = (k - s0) / (s1 - s0);
   }
   breaks[static_cast<std::size_t>(count++)] = 1.0;
-  std::sort(breaks.begin() + 1, breaks.begin() + count - 1);
+  // Insertion sort: a step crosses few planes.
+  for (int i = 2; i < count - 1; ++i) {
+    const double v = breaks[static_cast<std::size_t>(i)];
+    int j = i - 1;
+    while (j >= 1 && breaks[static_cast<std::size_t>(j)] > v) {
+      breaks[static_cast<std::size_t>(j + 1)] = breaks[static_cast<std::size_t>(j)];
+      --j;
+    }
+    breaks[static_cast<std::size_t>(j + 1)] = v;
+  }
   constexpr double kGauss = 0.28867513459481288225;  // 1/(2√3): the 2-point nodes at ½ ± this
   for (int piece = 0; piece + 1 < count; ++piece) {
     const double t0 = breaks[static_cast<std::size_t>(piece)], t1 = breaks[static_cast<std::size_t>(piece + 1)];

@@ -1,6 +1,7 @@
 #include "voxelize/procedural_shapes.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <initializer_list>
 #include <utility>
@@ -43,6 +44,33 @@ std::vector<ImplicitSolid> buildSphere(const ShapeParams& p, double) {
   const dvec3 c = p.vec("center");
   Material m = p.material(Material{});
   return {solid(regionName(p, "sphere", m), m, [=](const dvec3& x) { return glm::length(x - c) - r; }, c - r, c + r)};
+}
+
+// An upright prism over an equilateral triangle of side `side` in the xz plane (one corner towards
+// −z, turned by `rotate_deg` about +y), `height` tall along y. The distance is the largest of the
+// three faces' and the caps' plane distances: exact inside and on the faces, a bound outside.
+std::vector<ImplicitSolid> buildPrism(const ShapeParams& p, double) {
+  const double side = p.number("side"), height = p.number("height");
+  const double turn = glm::radians(p.number("rotate_deg"));
+  const dvec3 c = p.vec("center");
+  const double inradius = side / (2.0 * std::sqrt(3.0));
+  // Outward normals of the three side faces in the xz plane: the corner towards −z means the face
+  // opposite it faces +z.
+  std::array<dvec2, 3> normals;
+  for (int k = 0; k < 3; ++k) {
+    const double a = turn + k * 2.0 * 3.14159265358979323846 / 3.0;
+    normals[static_cast<std::size_t>(k)] = dvec2(std::sin(a), std::cos(a));
+  }
+  Material m = p.material(Material{});
+  const double r = 2.0 * inradius;  // circumradius
+  return {solid(regionName(p, "prism", m), m,
+                [=](const dvec3& x) {
+                  const dvec2 q(x.x - c.x, x.z - c.z);
+                  double d = std::abs(x.y - c.y) - 0.5 * height;
+                  for (const dvec2& n : normals) d = std::max(d, glm::dot(q, n) - inradius);
+                  return d;
+                },
+                c - dvec3(r, 0.5 * height, r), c + dvec3(r, 0.5 * height, r))};
 }
 
 std::vector<ImplicitSolid> buildBox(const ShapeParams& p, double) {
@@ -242,7 +270,8 @@ std::vector<ImplicitSolid> buildGradientSlab(const ShapeParams& p, double) {
                           c - half, c + half);
   // n rises linearly from n0 at the slab's −axis face to n1 at its +axis face.
   s.ior = [=](const dvec3& x) {
-    const double t = std::clamp((x[a] - c[a] + half[a]) / (2.0 * half[a]), 0.0, 1.0);
+    // Not clamped: with sharp interfaces n is continued over the band around the slab.
+    const double t = (x[a] - c[a] + half[a]) / (2.0 * half[a]);
     return n0 + (n1 - n0) * t;
   };
   return {s};
@@ -279,6 +308,11 @@ const std::vector<ShapeDef>& shapeDefs() {
     d.push_back({"box", "rectangular glass box",
                  {tripleParam("size", "1:1:1", 0.0, true, "side lengths X:Y:Z (one value: a cube)"), centerParam()},
                  allMaterialKeys(), {"box"}, buildBox});
+    d.push_back({"prism", "upright prism over an equilateral triangle (thesis Fig. 3.5b)",
+                 {positiveParam("side", "0.7", "side of the triangle"), positiveParam("height", "1", "height along y"),
+                  numberParam("rotate_deg", "0", -360.0, 360.0, false, "turn about +y (0: a corner towards -z)"),
+                  centerParam()},
+                 allMaterialKeys(), {"prism"}, buildPrism});
     d.push_back({"rounded_cube", "cube with rounded edges and corners",
                  {positiveParam("size", "1", "side length"), numberParam("radius", "0.1", 0.0, 1e300, false, "edge radius (<= size/2)"),
                   centerParam()},

@@ -1,0 +1,319 @@
+// The bake against exact optics (docs/testing.md): sharp interfaces, track deposits and receiver
+// maps checked against the independent tracer of tests/reference (exact analytic shapes, exact
+// Fresnel, every bounce) and against closed forms, never against a trace through the same voxels.
+// Sizes are the suite's: the 128³ figures of the issue are in BENCHMARKS.md (scripts/bench_exact_optics.sh).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "lightsim/cpu_simulator.h"
+#include "lightsim/interface_crossing.h"
+#include "lightsim/test_scenes.h"
+#include "tests/reference/exact_optics.h"
+
+namespace eik {
+namespace {
+
+using namespace test_scenes;
+
+// ---------------------------------------------------------------------------------------------
+// The glass sphere over a floor: R = 1, n = 1.5, centre 1.5 above the plane y = 0, the sun
+// straight down with irradiance 1. The paraxial focus (f = nR/(2(n − 1)) = 1.5 from the centre)
+// lies on the floor: a sharp caustic core, spherical aberration around it, the shadow's edge at
+// r = 1, and what the sphere reflects lands beyond it.
+
+struct Rings {
+  static constexpr int kCount = 9;
+  static constexpr double kEdges[kCount + 1] = {0.0, 0.1, 0.2, 0.3, 0.4, 0.6, 0.9, 1.0, 1.1, 1.3};
+  double irradiance[kCount] = {};
+  double encircled_02 = 0.0, encircled_1 = 0.0;
+  double shadow_radius = 0.0;  // where the mean irradiance first climbs past ½ going out from 0.9
+};
+
+// Rings of the receiver map around the caustic's centre, from the texels whose centres fall in them.
+Rings ringsOf(const ReceiverMap& map) {
+  Rings rings;
+  double flux[Rings::kCount] = {}, area[Rings::kCount] = {};
+  constexpr int kFine = 80;
+  double fine_sum[kFine] = {}, fine_count[kFine] = {};
+  const double a = map.pitch * map.pitch;
+  for (int j = 0; j < map.texels.y; ++j)
+    for (int i = 0; i < map.texels.x; ++i) {
+      const glm::dvec3 c = map.texelCenter(i, j);
+      const double r = std::hypot(c.x, c.z);
+      const double e = map.irradiance[3 * (static_cast<std::size_t>(j) * map.texels.x + i)];
+      if (r < 0.2) rings.encircled_02 += e * a;
+      if (r < 1.0) rings.encircled_1 += e * a;
+      for (int k = 0; k < Rings::kCount; ++k)
+        if (r >= Rings::kEdges[k] && r < Rings::kEdges[k + 1]) flux[k] += e * a, area[k] += a;
+      const int f = static_cast<int>((r - 0.9) / 0.0025);
+      if (f >= 0 && f < kFine) fine_sum[f] += e, fine_count[f] += 1.0;
+    }
+  for (int k = 0; k < Rings::kCount; ++k) rings.irradiance[k] = flux[k] / area[k];
+  for (int f = 0; f + 1 < kFine; ++f) {
+    const double lo = fine_sum[f] / fine_count[f], hi = fine_sum[f + 1] / fine_count[f + 1];
+    if (lo < 0.5 && hi >= 0.5) {
+      rings.shadow_radius = 0.9 + 0.0025 * (f + 0.5 + (0.5 - lo) / (hi - lo));
+      break;
+    }
+  }
+  return rings;
+}
+
+// The tracer's answer, once for all resolutions: 4·10⁶ rays over the floor's square (a ring of
+// width 0.1 near r = 1 gets some 10⁵ of them: ±0.3 %).
+const reference::ReceiverTally& exactSphereOnFloor() {
+  static const reference::ReceiverTally tally = [] {
+    reference::DirectionalBeam beam;
+    beam.beam_center = {0.0, 1.5, 0.0};
+    beam.beam_radius = 1.6 * std::sqrt(2.0);
+    reference::Receiver receiver;
+    receiver.ring_width = 0.01;
+    receiver.max_radius = 2.0;
+    reference::TraceOptions options;
+    options.rays = 4'000'000;
+    return reference::trace({reference::Solid::sphere({0.0, 1.5, 0.0}, 1.0, 1.5)}, beam, receiver, options);
+  }();
+  return tally;
+}
+
+struct SphereBake {
+  Rings rings;
+  double mean_deviation = 0.0, worst_deviation = 0.0;  // over the rings 0.1 ≤ r < 1.3
+  SimulationStats stats;
+};
+
+SphereBake bakeSphereOnFloor(int res) {
+  const Volume volume = sharpVolume("procedural:sphere,r=1,center=0:1.5:0,ior=1.5", res, std::nullopt, 2.0);
+  CpuSimulator sim(volume);
+  LightSpec light;  // straight down, irradiance 1
+  SimulationOptions options;
+  options.max_depth = 4;  // lightsim's default with sharp interfaces
+  ReceiverSpec floor;
+  floor.half_extent = 1.6;
+  options.receiver = floor;
+  const BakeResult bake = sim.run(light, options);
+  SphereBake result;
+  result.stats = bake.stats;
+  result.rings = ringsOf(bake.receivers.at(0));
+  const reference::ReceiverTally& exact = exactSphereOnFloor();
+  int counted = 0;
+  for (int k = 1; k < Rings::kCount; ++k) {
+    const double want = exact.ringIrradiance(Rings::kEdges[k], Rings::kEdges[k + 1]);
+    const double deviation = std::abs(result.rings.irradiance[k] / want - 1.0);
+    std::printf("%d³: ring %.1f–%.1f: bake %.4f exact %.4f (%+.2f %%)\n", res, Rings::kEdges[k], Rings::kEdges[k + 1],
+                result.rings.irradiance[k], want, 100.0 * (result.rings.irradiance[k] / want - 1.0));
+    result.mean_deviation += deviation;
+    result.worst_deviation = std::max(result.worst_deviation, deviation);
+    ++counted;
+  }
+  result.mean_deviation /= counted;
+  std::printf("%d³: mean deviation %.2f %%, worst %.2f %%, shadow radius %.4f, flux r<0.2 %.4f (exact %.4f), r<1 %.4f "
+              "(exact %.4f); %llu patch-steps\n",
+              res, 100.0 * result.mean_deviation, 100.0 * result.worst_deviation, result.rings.shadow_radius,
+              result.rings.encircled_02, exact.encircledFlux(0.2), result.rings.encircled_1, exact.encircledFlux(1.0),
+              static_cast<unsigned long long>(bake.stats.total_patches));
+  return result;
+}
+
+TEST(ExactOpticsSphere, CausticOnTheFloorConvergesToExactOptics) {
+  const SphereBake coarse = bakeSphereOnFloor(32), fine = bakeSphereOnFloor(48);
+  const reference::ReceiverTally& exact = exactSphereOnFloor();
+  // The issue's bound at 64³ is 10 % mean deviation (5 % at 128³); 48³ is measured at 2.8 %, 32³
+  // at 5.5 %. The error must fall with resolution: the discretisation converges.
+  EXPECT_LT(fine.mean_deviation, 0.10);
+  EXPECT_LT(fine.mean_deviation, coarse.mean_deviation);
+  EXPECT_LT(fine.worst_deviation, 0.2);  // the dim ring 0.9–1.0 (E ≈ 0.05): 10.5 % at 48³
+  // The shadow's edge stays at the sphere's radius (the smoothed boundary put it 8 % out):
+  // ±0.01 is 0.24 voxel at 48³.
+  EXPECT_NEAR(fine.rings.shadow_radius, 1.0, 0.01);
+  EXPECT_NEAR(coarse.rings.shadow_radius, 1.0, 0.01);
+  // Encircled flux: the caustic's core within 10 %, everything under the sphere within 3 %.
+  EXPECT_NEAR(fine.rings.encircled_02 / exact.encircledFlux(0.2), 1.0, 0.10);
+  EXPECT_NEAR(fine.rings.encircled_1 / exact.encircledFlux(1.0), 1.0, 0.03);
+  // The energy ledger closes, and almost all of the light reaches the floor or leaves upwards.
+  const SimulationStats& s = fine.stats;
+  EXPECT_LT(s.ledgerResidual(), 1e-9);
+  // Flux lost to kills (patches torn at the silhouette beyond the depth limit, light trapped by
+  // total internal reflection) and the step limit: measured 0.33 % of the sphere's own flux πR².
+  EXPECT_LT(s.flux_killed.x + s.flux_unfinished.x, 0.01 * std::numbers::pi);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Free air: a plane wave through a box of n = 1 deposits its exact irradiance in every voxel (the
+// track kernel: flux times path length with each voxel's trilinear hat), whatever the angle and
+// the resolution, with no smoothing; and a receiver under it reads E·cos θ in every texel.
+
+double worstFreeAirDeviation(int res, const glm::dvec3& direction, double* map_deviation) {
+  const GridSpec g = cubicGrid(res, 0.5);
+  CpuSimulator sim(uniformVolume(g, 1.0));
+  LightSpec light;
+  light.direction = glm::normalize(direction);
+  light.power = glm::dvec3(2.0);
+  SimulationOptions options;
+  ReceiverSpec floor;
+  floor.point = {0.0, -0.6, 0.0};
+  floor.half_extent = 0.4;
+  options.receiver = floor;
+  const BakeResult r = sim.run(light, options);
+  double worst = 0.0;
+  for (std::size_t v = 0; v < g.count(); ++v)
+    worst = std::max(worst, std::abs(r.irradiance.voxel(v)[0] / 2.0 - 1.0));
+  const ReceiverMap& map = r.receivers.at(0);
+  const double expected = 2.0 * -light.direction.y;  // planar irradiance: E·cos θ
+  *map_deviation = 0.0;
+  for (std::size_t t = 0; t < map.texelCount(); ++t)
+    *map_deviation = std::max(*map_deviation, std::abs(map.irradiance[3 * t] / expected - 1.0));
+  return worst;
+}
+
+TEST(ExactOpticsFreeAir, EveryVoxelAndTexelGetsTheBeamsIrradiance) {
+  for (int res : {32, 64})
+    for (const glm::dvec3& direction : {glm::dvec3(0, -1, 0), glm::dvec3(std::sin(0.6109), -std::cos(0.6109), 0.0),
+                                        glm::dvec3(0.3, -1.0, 0.45)}) {
+      double map = 0.0;
+      const double worst = worstFreeAirDeviation(res, direction, &map);
+      std::printf("free air %d³, light (%.2f, %.2f, %.2f): worst voxel %.3f %%, worst texel %.2e %%\n", res,
+                  direction.x, direction.y, direction.z, 100.0 * worst, 100.0 * map);
+      // 1 %: the issue's bound. Measured ≤ 0.45 % (the sub-path lattice of ½ voxel across the
+      // patch; exactly 0 along the axes).
+      EXPECT_LT(worst, 0.01) << res;
+      // The footprints tile the plane: each texel gets its exact share (to rounding).
+      EXPECT_LT(map, 1e-6) << res;
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// A glass slab, n = 1.5, 0.3 thick, horizontal and wider than the grid, in light tilted 35° from
+// the vertical: the beam leaves it parallel to itself, shifted sideways by d·sin(θi − θt)/cos θt,
+// and carrying (1 − R)² of its flux (R at θi going in equals R at θt going out).
+
+TEST(ExactOpticsSlab, ShiftsTheBeamBySnellsLawAndTransmitsTheFresnelFraction) {
+  const double n = 1.5, d = 0.3, theta_i = 35.0 * std::numbers::pi / 180.0;
+  const Bounds b = box({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5});
+  const Volume volume = sharpVolume("procedural:box,size=4:0.3:4,center=0:0:0,ior=1.5", 48, b);
+  CpuSimulator sim(volume);
+  const VolumeSampler& sampler = sim.sampler();
+  const double h = sampler.h();
+  const glm::dvec3 L(std::sin(theta_i), -std::cos(theta_i), 0.0);
+
+  // One corner through the slab (the bake's own stepping of a corner).
+  glm::dvec3 x(-0.3, 0.45, 0.0), w = L;
+  int medium = sampler.materialAt(x);
+  glm::dvec4 sample = sampler.materialOptics(medium, x);
+  for (int step = 0; step < 400 && x.y > -0.45; ++step)
+    advanceCornerSharp(x, w, medium, sample, 0.5 * h, Integrator::Euler, sampler);
+  // Snell: inside at θt, entering at y = 0.15 where the straight line from (−0.3, 0.45) meets it.
+  const double theta_t = std::asin(std::sin(theta_i) / n);
+  const double x_in = -0.3 + (0.45 - 0.15) * std::tan(theta_i);
+  const double x_out = x_in + d * std::tan(theta_t);
+  // The exact exit line: through (x_out, −0.15) along L. The corner's offset across it:
+  const glm::dvec3 off = x - glm::dvec3(x_out, -0.15, 0.0);
+  const double across = glm::length(off - glm::dot(off, L) * L);
+  const double shift = d * std::sin(theta_i - theta_t) / std::cos(theta_t);
+  std::printf("slab: Snell's shift %.5f; the corner is %.2e voxel off the exact shifted ray\n", shift, across / h);
+  EXPECT_LT(across, 0.05 * h);  // the issue's bound: 0.05 voxel
+  EXPECT_NEAR(glm::dot(glm::normalize(w), L), 1.0, 1e-9);  // parallel to the incident beam again
+
+  // The flux: a receiver under the slab, away from the grid's edges.
+  LightSpec light;
+  light.direction = L;
+  SimulationOptions options;
+  options.bounces = 0;  // single pass: the inter-reflection (R² = 0.2 %) is not followed
+  ReceiverSpec floor;
+  floor.point = {0.0, -0.6, 0.0};
+  floor.half_extent = 0.25;
+  options.receiver = floor;
+  const BakeResult r = sim.run(light, options);
+  const ReceiverMap& map = r.receivers.at(0);
+  double mean = 0.0;
+  for (std::size_t t = 0; t < map.texelCount(); ++t) mean += map.irradiance[3 * t];
+  mean /= static_cast<double>(map.texelCount());
+  const double R = reference::fresnelReflectance(1.0, n, std::cos(theta_i));
+  const double expected = std::cos(theta_i) * (1.0 - R) * (1.0 - R);
+  std::printf("slab: transmitted %.6f, Fresnel (1 − R)² cos θ %.6f (%+.3f %%)\n", mean, expected,
+              100.0 * (mean / expected - 1.0));
+  EXPECT_NEAR(mean / expected, 1.0, 0.005);  // the issue's bound: 0.5 %
+  EXPECT_LT(r.stats.ledgerResidual(), 1e-9);
+}
+
+// ---------------------------------------------------------------------------------------------
+// A prism, n = 1.5, apex 60°, lit at minimum deviation: behind it the light travels deviated by
+// D = 2·asin(n·sin(A/2)) − A = 37.18°.
+
+TEST(ExactOpticsPrism, BakedLightDirectionShowsTheMinimumDeviation) {
+  const double n = 1.5, apex = std::numbers::pi / 3.0;
+  const double deviation = 2.0 * std::asin(n * std::sin(apex / 2.0)) - apex;
+  // procedural:prism: a corner towards −z, face normals (sin a, 0, cos a) for a = 0°, 120°, 240°
+  // (the face at a = 0 facing +z, the base). The symmetric path enters the face of a = 240° and
+  // leaves by the face of a = 120°, running along +x inside, A/2 = 30° from the entry face's
+  // inward normal (at 30° from +x in the xz plane): the light arrives at 30° − θi and leaves at
+  // 30° − θi + D (angles from +x towards +z), θi = (A + D)/2.
+  // A black opaque wall over the base keeps the wide beam off it: a third beam, through the base
+  // and out of the exit face, would share the exit face's light.
+  const Bounds b = box({-0.8, -0.2, -0.8}, {0.8, 0.2, 0.8});
+  const Volume volume = sharpVolume(std::vector<std::string>{"procedural:prism,side=0.6,height=2,ior=1.5",
+                                     "procedural:box,size=0.64:2:0.04,center=0:0:0.19,albedo=0.05:0.05:0.05,name=wall"},
+                                    64, b);
+  CpuSimulator sim(volume);
+  const double theta_i = (apex + deviation) / 2.0;
+  const double in_angle = std::numbers::pi / 6.0 - theta_i, out_angle = in_angle + deviation;
+  LightSpec light;
+  light.direction = glm::dvec3(std::cos(in_angle), 0.0, std::sin(in_angle));
+  const BakeResult r = sim.run(light, SimulationOptions{});
+  const glm::dvec3 expected(std::cos(out_angle), 0.0, std::sin(out_angle));
+  // In front of the exit face (normal n, midpoint at the inradius; t along n, s along the face
+  // towards the base, s = ±0.3 at its ends): the beam through the entry face goes out at +18.6°
+  // (s = s₀ + 1.14 t), the direct light passes the base's corner (s > 0.3 + 0.3 t), and the rays
+  // that met the apex within a quarter voxel — where the voxelised distance rounds the edge — fan
+  // out at 20–46° from s₀ = −0.3 (s ≤ −0.3 + 4 t; measured: 1 % of the beam). Only the main beam
+  // reaches t ∈ [0.06, 0.1], s ∈ [0.15, 0.28]: average the baked direction there, weighted by E.
+  const GridSpec& g = volume.grid;
+  const glm::dvec3 exit_normal(std::sin(glm::radians(120.0)), 0.0, std::cos(glm::radians(120.0)));
+  const glm::dvec3 along(-exit_normal.z, 0.0, exit_normal.x);
+  const double inradius = 0.6 / (2.0 * std::sqrt(3.0));
+  glm::dvec3 sum(0.0);
+  for (int k = 0; k < g.dims.z; ++k)
+    for (int j = g.dims.y / 2 - 2; j <= g.dims.y / 2 + 2; ++j)
+      for (int i = 0; i < g.dims.x; ++i) {
+        const glm::dvec3 c = g.center(i, j, k);
+        const double t = glm::dot(c, exit_normal) - inradius, s_along = glm::dot(c - inradius * exit_normal, along);
+        if (t < 0.06 || t > 0.1 || s_along < 0.15 || s_along > 0.28) continue;
+        const float* e = r.irradiance.voxel(g.index(i, j, k));
+        const float* dir = r.light_dir.voxel(g.index(i, j, k));
+        sum += static_cast<double>(e[0]) * glm::dvec3(dir[0], dir[1], dir[2]);
+      }
+  const glm::dvec3 mean = glm::normalize(sum);
+  const double error_deg = glm::degrees(std::acos(std::min(1.0, glm::dot(mean, expected))));
+  std::printf("prism: baked light direction behind it (%.4f, %.4f, %.4f), minimum deviation %.3f°: %.3f° off\n",
+              mean.x, mean.y, mean.z, glm::degrees(deviation), error_deg);
+  EXPECT_LT(error_deg, 0.1);  // the issue's bound
+}
+
+// ---------------------------------------------------------------------------------------------
+// The Luneburg lens, n(r) = sqrt(2 − (r/R)²), graded with no jump at its surface: with sharp
+// interfaces it is one graded material, and a plane wave still focuses on the far surface.
+
+TEST(ExactOpticsLuneburg, GradedLensFocusesOnTheFarSurfaceWithinHalfAVoxel) {
+  const double h = 1.0 / 30.0, R = 0.5;
+  const Bounds b = box({-18.5 * h, -0.6 - 18.5 * h, -18.5 * h}, {18.5 * h, 0.6 - 0.5 * h, 18.5 * h});
+  const Volume v = sharpVolume("procedural:luneburg,r=0.5", 54, b);
+  ASSERT_EQ(v.grid.dims, glm::ivec3(37, 54, 37));
+  CpuSimulator sim(v);
+  const BakeResult r = sim.run(LightSpec{}, SimulationOptions{});
+  const GridSpec& g = v.grid;
+  int best = -1;
+  double best_e = -1.0;
+  for (int j = 0; j < g.dims.y && g.center(0, j, 0).y < 0.0; ++j) {
+    const double e = r.irradiance.voxel(g.index(g.dims.x / 2, j, g.dims.z / 2))[0];
+    if (e > best_e) best_e = e, best = j;
+  }
+  const double y_max = g.center(0, best, 0).y;
+  std::printf("Luneburg (sharp): on-axis maximum at %.4f, focus at %.4f: %.2f voxels off\n", y_max, -R, (y_max + R) / h);
+  EXPECT_LT(std::abs(y_max + R), 0.5 * h);  // the grid puts a voxel centre on the focus
+}
+
+}  // namespace
+}  // namespace eik
