@@ -1,6 +1,8 @@
 #include "lightsim/interface_crossing.h"
 
 #include <algorithm>
+#include <array>
+#include <utility>
 #include <cmath>
 
 namespace eik {
@@ -40,9 +42,12 @@ void rayStep(glm::dvec3& x, glm::dvec3& w, const glm::dvec4& sample, double dt, 
   }
 }
 
-// The material just past the surface of slot k at p, entering it (inside) or leaving it.
-int materialBeyond(const VolumeSampler& sampler, const glm::dvec3& p, int k, bool inside) {
-  glm::dvec4 d = sampler.distances(p);
+// The material just past the surface of slot k at p, entering it (inside) or leaving it, going
+// along `dir`: the distances a tenth of a voxel on, with slot k's on the far side of its surface.
+// Looking past p matters where two slots share a surface (layers of glass touching): both change
+// sign there, and at p itself the other's sign is noise.
+int materialBeyond(const VolumeSampler& sampler, const glm::dvec3& p, const glm::dvec3& dir, int k, bool inside) {
+  glm::dvec4 d = sampler.distances(p + (0.1 * sampler.h()) * dir);
   d[k] = inside ? -1.0 : 1.0;
   return materialSlot(d, sampler.slotCount());
 }
@@ -52,9 +57,10 @@ int materialBeyond(const VolumeSampler& sampler, const glm::dvec3& p, int k, boo
 bool findInterface(const VolumeSampler& sampler, const glm::dvec3& a, const glm::dvec3& b, int from, InterfaceHit& hit) {
   const glm::dvec4 da = sampler.distances(a), db = sampler.distances(b);
   if (materialSlot(db, sampler.slotCount()) == from) return false;
-  // The slot surfaces the chord crosses, in order along it; the first that changes the material.
-  double best = 2.0;
-  int best_slot = -1;
+  // The slot surfaces the chord crosses, in order along it: the first that changes the material
+  // is the interface (crossing an outer slot's surface inside an inner slot changes nothing).
+  std::array<std::pair<double, int>, kMaxInterfaceSlots> crossings{};
+  int count = 0;
   for (int k = 0; k < sampler.slotCount(); ++k) {
     const bool in_a = da[k] < 0.0, in_b = db[k] < 0.0;
     if (in_a == in_b) continue;
@@ -73,24 +79,30 @@ bool findInterface(const VolumeSampler& sampler, const glm::dvec3& a, const glm:
       }
       f = g0 == g1 ? 0.5 * (f0 + f1) : f0 + (f1 - f0) * g0 / (g0 - g1);
     }
-    if (f < best) {
-      best = f;
-      best_slot = k;
-    }
+    crossings[static_cast<std::size_t>(count++)] = {f, k};
   }
-  if (best_slot < 0) {
-    // The corner's own material disagrees with the distances at a (it sits on a surface it just
-    // crossed): the crossing is here, on the surface of its material or of the one ahead.
-    hit.fraction = 0.0;
-    hit.slot = from >= 0 ? from : materialSlot(db, sampler.slotCount());
-    hit.entered = materialSlot(db, sampler.slotCount());
-    return hit.slot >= 0;
+  // Insertion sort of at most kMaxInterfaceSlots entries (std::sort on a partly used std::array
+  // trips GCC 12's -Warray-bounds).
+  for (int i = 1; i < count; ++i)
+    for (int j = i; j > 0 && crossings[static_cast<std::size_t>(j)] < crossings[static_cast<std::size_t>(j - 1)]; --j)
+      std::swap(crossings[static_cast<std::size_t>(j)], crossings[static_cast<std::size_t>(j - 1)]);
+  int current = from;
+  for (int i = 0; i < count; ++i) {
+    const auto [f, k] = crossings[static_cast<std::size_t>(i)];
+    const int beyond = materialBeyond(sampler, a + f * (b - a), glm::normalize(b - a), k, !(da[k] < 0.0));
+    if (beyond == current) continue;
+    hit.fraction = f;
+    hit.slot = k;
+    hit.entered = beyond;
+    return true;
   }
-  const glm::dvec3 p = a + best * (b - a);
-  hit.fraction = best;
-  hit.slot = best_slot;
-  hit.entered = materialBeyond(sampler, p, best_slot, !(da[best_slot] < 0.0));
-  return true;
+  // No surface along the chord changes the corner's material, yet the end is in another one: the
+  // corner sits on a surface it just crossed (its own material disagrees with the distances at a).
+  // The crossing is here, on the surface of its material or of the one ahead.
+  hit.fraction = 0.0;
+  hit.slot = from >= 0 ? from : materialSlot(db, sampler.slotCount());
+  hit.entered = materialSlot(db, sampler.slotCount());
+  return hit.slot >= 0;
 }
 
 Refraction refract(const glm::dvec3& d, const glm::dvec3& normal, double n1, double n2) {

@@ -33,11 +33,11 @@ ReceiverMap receiverGeometry(const ReceiverSpec& spec, const LightSpec& light, c
     lo = glm::min(lo, uv);
     hi = glm::max(hi, uv);
   }
-  if (spec.half_extent < 1e29) {
-    // A bounded plane is mapped whole: light the object reflects or bends lands beyond its shadow.
-    lo = glm::dvec2(-spec.half_extent);
-    hi = glm::dvec2(spec.half_extent);
-  }
+  // Light the object reflects or bends lands beyond its shadow: the map reaches one shadow-size
+  // further on every side, within the plane's square.
+  const glm::dvec2 grow(std::max(hi.x - lo.x, hi.y - lo.y));
+  lo = glm::max(lo - grow, glm::dvec2(-spec.half_extent));
+  hi = glm::min(hi + grow, glm::dvec2(spec.half_extent));
   if (!(lo.x < hi.x && lo.y < hi.y))
     throw InputError("receiver", spec.name, "the volume's box does not shade any part of the plane's square");
   map.pitch = spec.pitch_voxels * voxelEdge(grid);

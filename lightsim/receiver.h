@@ -24,16 +24,16 @@ namespace eik {
 
 struct Patch;
 
-// The map's geometry for a bake: the square of half extent `spec.half_extent` around `spec.point`
-// (light the object reflects or bends may land anywhere on it), or for an unbounded plane the part
-// the volume can shade, the box `box_lo`..`box_hi` seen from the light (projected along a
-// directional light, or from a point light) onto the plane; texels of spec.pitch_voxels·h (h the
-// grid's smallest voxel edge; coarser if the map would exceed kMaxReceiverTexels per axis). The
-// irradiance is left empty. Throws InputError naming "receiver" when the light does not reach the
-// plane from its front (normal) side.
+// The map's geometry for a bake: the box `box_lo`..`box_hi` seen from the light (projected along a
+// directional light, or from a point light) onto the plane — the volume's shadow — grown by its
+// own size on every side (for the light the object reflects or bends beyond it), within the square
+// of half extent `spec.half_extent` around `spec.point`; texels of spec.pitch_voxels·h (h the
+// grid's smallest voxel edge; coarser if the map would exceed kMaxReceiverTexels per axis, the
+// NRRD limit). The irradiance is left empty. Throws InputError naming "receiver" when the light
+// does not reach the plane from its front (normal) side.
 ReceiverMap receiverGeometry(const ReceiverSpec& spec, const LightSpec& light, const GridSpec& grid,
                              const glm::dvec3& box_lo, const glm::dvec3& box_hi);
-constexpr int kMaxReceiverTexels = 4096;
+constexpr int kMaxReceiverTexels = 1024;
 
 // Where the rays of a patch's corners (x_c along w_c) meet the plane, in the plane's (u, v)
 // coordinates. False when a corner's ray runs parallel to the plane.

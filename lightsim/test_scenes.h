@@ -60,6 +60,7 @@ inline Volume proceduralVolume(const std::string& spec_text, int res, std::optio
   const ProceduralSpec spec = parseProceduralSpec(spec_text);
   const GridSpec grid = makeGrid(proceduralBounds(spec), res, pad_voxels, bounds);
   PipelineOptions options;
+  options.interfaces = InterfaceMode::Smooth;
   options.smooth_sigma_voxels = smooth_sigma_voxels;
   return buildVolume(voxelizeProcedural(spec, grid), grid, options);
 }

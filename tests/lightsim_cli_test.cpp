@@ -15,10 +15,13 @@
 namespace eik::test {
 namespace {
 
-void makeSphere(const TempDir& dir) {
+// A smoothed ball (the thesis' mode, which the GPU path bakes) and, with `sharp`, one with sharp
+// interfaces (voxelize's default).
+void makeSphere(const TempDir& dir, bool sharp = false) {
   ProgramResult r = runProgram(VOXELIZE_EXE,
-                               {"procedural:sphere,r=0.5,ior=1.5,sigma_a=0.2:0.4:0.8", "-o", "ball.vol.json", "--res",
-                                "16", "--quiet"},
+                               {"procedural:sphere,r=0.5,ior=1.5,sigma_a=0.2:0.4:0.8", "-o",
+                                sharp ? "sharp.vol.json" : "ball.vol.json", "--res", "16", "--interfaces",
+                                sharp ? "sharp" : "smooth", "--quiet"},
                                dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.output;
 }
@@ -82,6 +85,13 @@ TEST(LightsimCli, TheGpuPathRefusesWhatItCannotDoYet) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--backend: gl: the GPU path does not do track deposits"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "g.vol.json"));
+  makeSphere(dir, true);
+  r = runProgram(LIGHTSIM_EXE,
+                 {"sharp.vol.json", "-o", "s.vol.json", "--light", "directional:0,-1,0", "--backend", "gl",
+                  "--deposit-kernel", "point"},
+                 dir.path());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("the GPU path does not do sharp interfaces"), std::string::npos) << r.output;
 }
 
 // --smooth-irradiance is a normalised filter: the light's total stays (the sphere sits well inside
@@ -92,7 +102,8 @@ TEST(LightsimCli, SmoothedIrradianceKeepsTheTotalAndLosesTheGrain) {
   for (const char* sigma : {"0", "1"}) {
     ProgramResult r = runProgram(LIGHTSIM_EXE,
                                  {"ball.vol.json", "-o", std::string("s") + sigma + ".vol.json", "--light",
-                                  "directional:0.3,-1,0.2", "--backend", "cpu", "--smooth-irradiance", sigma, "--quiet"},
+                                  "directional:0.3,-1,0.2", "--backend", "cpu", "--deposit-kernel", "point",
+                                  "--smooth-irradiance", sigma, "--quiet"},
                                  dir.path());
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }

@@ -22,7 +22,7 @@ enum class InterfaceMode { Sharp, Smooth };
 struct PipelineOptions {
   // Sharp (default): buildSharpVolume (sharp_interfaces.h); every region must carry its distance.
   // Smooth: the thesis' pre-smoothed n, below.
-  InterfaceMode interfaces = InterfaceMode::Smooth;  // TODO(exact-optics): Sharp once lightsim and viewer read it
+  InterfaceMode interfaces = InterfaceMode::Sharp;
   double band = 0.0;  // Sharp: the distance band in world units (0: kInterfaceBandVoxels voxels)
   double smooth_sigma_voxels = kDefaultSmoothSigmaVoxels;  // σ of the pre-smoothing of n; 0: none
   GradientOperator gradient = GradientOperator::Isotropic;  // how ∇n is differenced (field_filters.h)
@@ -49,7 +49,7 @@ struct VoxelizeOptions {
   int res = 128;                    // voxels along the longest axis of the objects
   std::string bounds;               // explicit world box "MINX,MINY,MINZ,MAXX,MAXY,MAXZ" (empty: from the objects)
   double pad = kDefaultPadVoxels;   // voxels of air around the objects
-  std::string interfaces = "smooth";  // sharp or smooth (the thesis' pre-smoothed n)
+  std::string interfaces = "sharp";  // sharp, or smooth (the thesis' pre-smoothed n)
   double smooth = kDefaultSmoothSigmaVoxels;  // σ of the pre-smoothing of n, in voxels (smooth mode)
   std::vector<std::string> materials;  // --material specs: one for all OBJ/procedural inputs, or one each
   int supersample = 4;              // sub-samples per voxel and axis

@@ -55,12 +55,20 @@ struct SphereCase {
   Volume volume;
 };
 
+// The thesis' smoothed mode, which most of these tests are about (sharp interfaces:
+// sharp_interfaces_test.cpp).
+PipelineOptions smoothed() {
+  PipelineOptions options;
+  options.interfaces = InterfaceMode::Smooth;
+  return options;
+}
+
 // A glass sphere (n = 1.5) of radius 0.5 on a 128³ grid: 122 voxels across plus 3 of air per side.
 SphereCase sphere(GradientOperator op = GradientOperator::Isotropic) {
   SphereCase s;
   const ProceduralSpec spec = parseProceduralSpec("procedural:sphere,r=0.5,ior=1.5");
   s.grid = makeGrid(proceduralBounds(spec), 122, 3.0);
-  PipelineOptions options;
+  PipelineOptions options = smoothed();
   options.smooth_sigma_voxels = kSigma;
   options.gradient = op;
   s.volume = buildVolume(voxelizeProcedural(spec, s.grid), s.grid, options);
@@ -192,7 +200,7 @@ TEST(Pipeline, PlainCentralDifferencesAreLessIsotropic) {
 TEST(Pipeline, LuneburgIndexAndGradientFollowTheFormula) {
   const ProceduralSpec spec = parseProceduralSpec("procedural:luneburg,r=0.5");
   const GridSpec grid = makeGrid(proceduralBounds(spec), 90, 3.0);
-  const Volume v = buildVolume(voxelizeProcedural(spec, grid), grid);
+  const Volume v = buildVolume(voxelizeProcedural(spec, grid), grid, smoothed());
   const Field& n = v.fields.at("ior");
   const Field& grad = v.fields.at("ior_grad");
   const double R = 0.5, h = grid.voxelSize().x;
@@ -235,7 +243,7 @@ TEST(Pipeline, LuneburgIndexAndGradientFollowTheFormula) {
 TEST(Pipeline, GradientSlabIsLinearWithConstantGradient) {
   const ProceduralSpec spec = parseProceduralSpec("procedural:gradient_slab,size=1:0.5:0.5,n0=1.2,n1=1.8,axis=x");
   const GridSpec grid = makeGrid(proceduralBounds(spec), 80, 3.0);
-  const Volume v = buildVolume(voxelizeProcedural(spec, grid), grid);
+  const Volume v = buildVolume(voxelizeProcedural(spec, grid), grid, smoothed());
   const Field& n = v.fields.at("ior");
   const Field& grad = v.fields.at("ior_grad");
   const double h = grid.voxelSize().x;
@@ -264,13 +272,13 @@ TEST(Pipeline, NoSmoothingKeepsTheRawComposite) {
   const ProceduralSpec spec = parseProceduralSpec("procedural:sphere,r=0.4,sigma_a=1:2:3");
   const GridSpec grid = makeGrid(proceduralBounds(spec), 24, 2.0);
   const auto regions = voxelizeProcedural(spec, grid);
-  PipelineOptions options;
+  PipelineOptions options = smoothed();
   options.smooth_sigma_voxels = 0.0;
   const Volume v = buildVolume(regions, grid, options);
   for (std::size_t i = 0; i < grid.count(); ++i)
     ASSERT_FLOAT_EQ(v.fields.at("ior").data[i], 1.0f + 0.5f * regions[0].coverage[i]);
   // σa is never smoothed (only n is, as in the thesis).
-  PipelineOptions smooth;
+  PipelineOptions smooth = smoothed();
   const Volume s = buildVolume(regions, grid, smooth);
   EXPECT_EQ(s.fields.at("sigma_a").data, v.fields.at("sigma_a").data);
   EXPECT_NE(s.fields.at("ior").data, v.fields.at("ior").data);
@@ -282,7 +290,7 @@ TEST(Pipeline, NoSmoothingKeepsTheRawComposite) {
 TEST(Pipeline, DispersionIsSmoothedWithTheIndex) {
   const ProceduralSpec spec = parseProceduralSpec("procedural:sphere,r=0.4,ior=1.75,abbe=20");
   const GridSpec grid = makeGrid(proceduralBounds(spec), 32, 3.0);
-  const Volume v = buildVolume(voxelizeProcedural(spec, grid), grid);
+  const Volume v = buildVolume(voxelizeProcedural(spec, grid), grid, smoothed());
   const Field& n = v.fields.at("ior");
   const Field& b = v.fields.at("dispersion");
   const double ratio = 0.523655 / 20.0;  // B = 0.523655·(n_d − 1)/V_d
@@ -303,7 +311,7 @@ TEST(Pipeline, ReportsProgressUpToOne) {
   const GridSpec grid = makeGrid(proceduralBounds(spec), 16, 2.0);
   std::vector<double> seen;
   std::mutex m;
-  PipelineOptions options;
+  PipelineOptions options = smoothed();
   options.progress = [&](double f) {
     std::lock_guard<std::mutex> lock(m);
     seen.push_back(f);
@@ -331,7 +339,9 @@ TEST(VoxelizeFiles, WritesTheVolumeTheStepsBuild) {
 
   const ProceduralSpec spec = parseProceduralSpec(options.inputs[0]);
   const GridSpec grid = makeGrid(proceduralBounds(spec), 12);
-  const Volume expected = buildVolume(voxelizeProcedural(spec, grid), grid);
+  ProceduralOptions sharp;  // voxelize's default: sharp interfaces
+  sharp.distance_band = interfaceBand(grid);
+  const Volume expected = buildVolume(voxelizeProcedural(spec, grid, sharp), grid);
   const Volume written = readVolume(dir / "sphere.vol.json");
   EXPECT_EQ(written.grid.dims, grid.dims);
   ASSERT_EQ(written.fields.size(), expected.fields.size());

@@ -31,10 +31,10 @@ double coverageSum(const Region& r) {
 // n³ voxels on [−half, half]³.
 GridSpec centredGrid(int n, double half) { return cubeGrid(glm::dvec3(0.0), 2.0 * half, n); }
 
-TEST(ProceduralShapes, TableNamesNineShapesWithTheirRegions) {
-  ASSERT_EQ(shapeDefs().size(), 9u);
+TEST(ProceduralShapes, TableNamesTenShapesWithTheirRegions) {
+  ASSERT_EQ(shapeDefs().size(), 10u);
   EXPECT_EQ(shapeNames(),
-            "sphere, box, rounded_cube, layered_cube, wine_glass, logo_block, luneburg, gradient_slab, floor");
+            "sphere, box, prism, rounded_cube, layered_cube, wine_glass, logo_block, luneburg, gradient_slab, floor");
   for (const ShapeDef& shape : shapeDefs()) {
     EXPECT_EQ(&findShape(shape.name, "test"), &shape);
     ASSERT_TRUE(shape.build) << shape.name;
@@ -268,6 +268,21 @@ TEST(Procedural, FloorIsAnOpaqueLayerOneVoxelThick) {
     for (int j = 0; j < grid.dims.y; ++j) column += floor.coverage[grid.index(i, j, 16)];
     EXPECT_NEAR(column, 1.0, 1e-5) << i;
   }
+}
+
+// The prism: the faces are planes at the inradius side/(2√3) from its axis, with a corner towards
+// −z, and the caps at ±height/2.
+TEST(ProceduralShapes, PrismFacesLieAtTheInradius) {
+  const auto solids = buildShapeSolids(parseProceduralSpec("procedural:prism,side=0.6,height=1,center=0.1:0:0"), 0.01);
+  ASSERT_EQ(solids.size(), 1u);
+  const auto& sdf = solids[0].sdf;
+  const double inradius = 0.6 / (2.0 * std::sqrt(3.0));
+  EXPECT_NEAR(sdf({0.1, 0.0, inradius}), 0.0, 1e-12);                        // the face facing +z
+  EXPECT_NEAR(sdf({0.1, 0.0, -2.0 * inradius}), 0.0, 1e-12);                 // the corner towards −z
+  EXPECT_NEAR(sdf({0.1, 0.0, 0.0}), -inradius, 1e-12);                       // the axis
+  EXPECT_NEAR(sdf({0.1, 0.5, 0.0}), 0.0, 1e-12);                             // the top cap
+  EXPECT_NEAR(sdf({0.1 + inradius * std::sin(2.0944) + 0.05, 0.0, inradius * std::cos(2.0944) + 0.05 * 0.0}),
+              0.05 * std::sin(2.0944), 1e-4);  // beside the face facing (sin 120°, cos 120°)
 }
 
 }  // namespace

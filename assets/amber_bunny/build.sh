@@ -9,4 +9,4 @@ voxelize "$ASSETS/meshes/bunny.obj" \
          --material ior=1.55,sigma_a=0.25:0.9:2.8,scatter=0.6,g=0.3,name=amber \
          --material name=grain --material name=grain --material name=grain --material name=smoke \
          -o amber_bunny.vol.json --res "$(res 80)"
-lightsim amber_bunny.vol.json -o amber_bunny.baked.vol.json --smooth-irradiance 1
+lightsim amber_bunny.vol.json -o amber_bunny.baked.vol.json

@@ -4,4 +4,4 @@
 voxelize procedural:sphere,r=0.45,center=0:-0.05:0 \
          procedural:sphere,r=0.12,center=0:-0.05:0,emission=6:2.6:0.7,name=core \
          -o glass_sphere.vol.json --res "$(res 96)" --bounds -0.55,-0.53,-0.55,0.8,0.45,0.75
-lightsim glass_sphere.vol.json -o glass_sphere.baked.vol.json --smooth-irradiance 1
+lightsim glass_sphere.vol.json -o glass_sphere.baked.vol.json

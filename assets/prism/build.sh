@@ -3,5 +3,5 @@
 # red, green and blue viewing rays part most: a rainbow band beside the totally reflecting part.
 # n is smoothed a little more than the default (1.25 voxels) so the steep rays stay clean. It
 # floats with no ground and scatters nothing, so it needs no bake.
-voxelize "$SCENE_DIR/prism.obj" --material ior=1.75,abbe=20,name=flint --smooth 1.25 \
+voxelize "$SCENE_DIR/prism.obj" --material ior=1.75,abbe=20,name=flint \
          -o prism.vol.json --res "$(res 96)"

@@ -427,9 +427,8 @@ void stepRay@(inout March@ m, vec3 grad, float hs, float cauchy) {
 // to x is cut where the first slot distance that changed sign is zero (linear interpolation, one
 // regula falsi refinement), and there, with the normal ∇d of that slot and n on both sides:
 // into an opaque material the ray stops and sees its surface (ρE/π); past the critical angle it
-// reflects totally; else Snell's law bends it and the exact Fresnel R (corrected Eq. 3.6) sends
-// R of it to the reflected direction (the environment, seen from outside the denser medium, as
-// crossBoundary) and keeps 1 − R. The ray goes on from the interface. True when the ray stopped.
+// reflects totally; else the exact Fresnel R (corrected Eq. 3.6) splits it between the mirrored
+// ray and the one Snell's law bends. The ray goes on from the interface. True when it stopped.
 bool crossInterface@(inout Ray r, inout March@ m, float cauchy) {
 #ifdef HAS_INTERFACES
   vec3 x0 = m.xStepStart, x1 = m.x;
@@ -437,25 +436,44 @@ bool crossInterface@(inout Ray r, inout March@ m, float cauchy) {
   vec4 d1 = volumeInterfaces((x1 - m.bmin) * m.invExtent);
   int next = materialAt@(d1);
   if (next == m.medium) return false;
-  float best = 2.0;
-  int slot = -1;
+  // Where each slot's distance changes sign along the chord; then, in order along it, the first
+  // surface that changes the material (an outer slot's surface inside an inner one changes nothing).
+  vec4 f = vec4(2.0);
   for (int k = 0; k < INTERFACE_SLOTS; ++k) {
     if ((d0[k] < 0.0) == (d1[k] < 0.0)) continue;
-    float f = d0[k] / (d0[k] - d1[k]);
-    float g = volumeInterfaces((mix(x0, x1, f) - m.bmin) * m.invExtent)[k];
-    f = (g < 0.0) == (d0[k] < 0.0) ? f + (1.0 - f) * g / (g - d1[k]) : f * d0[k] / (d0[k] - g);
-    if (f < best) { best = f; slot = k; }
+    float t = d0[k] / (d0[k] - d1[k]);
+    float g = volumeInterfaces((mix(x0, x1, t) - m.bmin) * m.invExtent)[k];
+    f[k] = (g < 0.0) == (d0[k] < 0.0) ? t + (1.0 - t) * g / (g - d1[k]) : t * d0[k] / (d0[k] - g);
+  }
+  float best = 0.0;
+  int slot = -1, entered = m.medium;
+  for (int pass = 0; pass < INTERFACE_SLOTS; ++pass) {
+    int k = -1;
+    float nearest = 1.5;  // the earliest crossing not yet looked at
+    for (int j = 0; j < INTERFACE_SLOTS; ++j)
+      if (f[j] < nearest) { nearest = f[j]; k = j; }
+    if (k < 0) break;
+    f[k] = 3.0;
+    // Just past the surface: a tenth of a voxel on (where two slots share a surface, layers of
+    // glass touching, both change sign there, and at the surface the other's sign is noise).
+    vec3 beyondX = mix(x0, x1, nearest) + normalize(x1 - x0) * (0.2 * m.h);  // m.h: half a voxel by default
+    vec4 dp = volumeInterfaces((beyondX - m.bmin) * m.invExtent);
+    dp[k] = (d0[k] < 0.0) ? 1.0 : -1.0;
+    int beyond = materialAt@(dp);
+    if (beyond != m.medium) {
+      slot = k;
+      entered = beyond;
+      best = nearest;
+      break;
+    }
   }
   if (slot < 0) {  // on a surface already (the medium disagrees with d0): the crossing is at x0
     best = 0.0;
     slot = m.medium >= 0 ? m.medium : next;
+    entered = next;
   }
   vec3 p = mix(x0, x1, best);
-  vec4 dp = volumeInterfaces((p - m.bmin) * m.invExtent);
-  dp[slot] = (d0[slot] < 0.0) ? 1.0 : -1.0;  // just past the surface
-  int entered = materialAt@(dp);
   m.x = p;
-  if (entered == m.medium) return false;
   vec3 e = 0.5 / m.invExtent / vec3(textureSize(INTERFACES_SAMPLER, 0));  // half a voxel
   vec3 normal = vec3(
       volumeInterfaces((p + vec3(e.x, 0, 0) - m.bmin) * m.invExtent)[slot] - volumeInterfaces((p - vec3(e.x, 0, 0) - m.bmin) * m.invExtent)[slot],
@@ -488,15 +506,27 @@ bool crossInterface@(inout Ray r, inout March@ m, float cauchy) {
     m.n = n1;
     return false;
   }
+  vec3 refracted = refract(d, facing, n1 / n2);
+  vec3 mirrored = reflect(d, facing);
 #ifdef FRESNEL
+  // One ray goes on: the transmitted one, or the reflected one where it carries more (R > ½, near
+  // the critical angle from inside a denser material, so that the light does not vanish there
+  // into a near-grazing refracted ray). The other branch is taken as the environment seen in its
+  // direction (outside the object exactly; for a reflection inside it, an approximation of the
+  // light that would come back through the object).
   float R = fresnelUnpolarised(n1, n2, cosI, sqrt(1.0 - sin2T));
-  if (n2 > n1) {
-    vec3 reflected = normalize(mat3(uObjVolToWorld[@]) * reflect(d, facing));
-    r.radiance += r.T * exp(-m.tau) * R * environmentRadiance(reflected, uReflectionLod);
+  vec3 weight = r.T * exp(-m.tau);
+  if (R > 0.5) {
+    r.radiance += weight * (1.0 - R) * environmentRadiance(normalize(mat3(uObjVolToWorld[@]) * refracted), uReflectionLod);
+    r.T *= R;
+    m.w = mirrored * n1;
+    m.n = n1;
+    return false;
   }
+  r.radiance += weight * R * environmentRadiance(normalize(mat3(uObjVolToWorld[@]) * mirrored), uReflectionLod);
   r.T *= 1.0 - R;
 #endif
-  m.w = refract(d, facing, n1 / n2) * n2;
+  m.w = refracted * n2;
   m.n = n2;
   m.medium = entered;
 #endif

@@ -1,0 +1,68 @@
+// The interfaces table of a volume (interfaces.h): read strictly, and the material a point is in.
+#include "core/interfaces.h"
+
+#include <gtest/gtest.h>
+
+#include "core/testing.h"
+
+namespace eik {
+namespace {
+
+using test_support::inputErrorOf;
+
+Volume withTable(const nlohmann::json& table) {
+  Volume v;
+  v.grid.dims = {2, 2, 2};
+  v.grid.bounds_max = glm::dvec3(1.0);
+  v.addField("interfaces", 4);
+  v.metadata["interfaces"] = table;
+  return v;
+}
+
+TEST(Interfaces, ReadsTheSlotsInnermostFirst) {
+  const InterfaceTable t = interfaceTable(withTable(
+      {{"band", 0.1},
+       {"slots", {{{"name", "wine"}, {"ior", 1.34}}, {{"name", "glass"}, {"ior", 1.5}, {"dispersion_b", 0.004}},
+                  {{"name", "lens"}, {"ior", 1.0}, {"graded", true}}, {{"name", "opaque"}, {"opaque", true}}}}}));
+  ASSERT_EQ(t.slots.size(), 4u);
+  EXPECT_EQ(t.slots[0].name, "wine");
+  EXPECT_DOUBLE_EQ(t.slots[1].dispersion_b, 0.004);
+  EXPECT_TRUE(t.slots[2].graded);
+  EXPECT_TRUE(t.slots[3].opaque);
+  EXPECT_DOUBLE_EQ(t.band, 0.1);
+  // It survives a round trip.
+  EXPECT_EQ(interfaceTable(withTable(t.toJson())).slots[1].ior, 1.5);
+}
+
+TEST(Interfaces, AVolumeWithoutThemHasAnEmptyTable) {
+  Volume v;
+  v.grid.dims = {2, 2, 2};
+  EXPECT_TRUE(interfaceTable(v).empty());
+}
+
+TEST(Interfaces, MalformedTablesNameTheKey) {
+  EXPECT_CONTAINS(inputErrorOf([] { interfaceTable(withTable({{"slots", {{{"ior", 1.5}}}}})); }), "interfaces.band");
+  EXPECT_CONTAINS(inputErrorOf([] { interfaceTable(withTable({{"band", 0.1}, {"slots", nlohmann::json::array()}})); }),
+                  "1 to 4 slots");
+  EXPECT_CONTAINS(inputErrorOf([] {
+                    interfaceTable(withTable({{"band", 0.1}, {"slots", {{{"ior", 0.5}}}}}));
+                  }),
+                  "interfaces.slots[0].ior");
+  EXPECT_CONTAINS(inputErrorOf([] {
+                    interfaceTable(withTable({{"band", 0.1}, {"slots", {{{"colour", 1}}}}}));
+                  }),
+                  "interfaces.slots[0].colour: unknown key");
+  Volume no_table;
+  no_table.grid.dims = {2, 2, 2};
+  no_table.addField("interfaces", 4);
+  EXPECT_CONTAINS(inputErrorOf([&] { interfaceTable(no_table); }), "no interfaces table");
+}
+
+TEST(Interfaces, TheMaterialIsTheFirstSlotWithANegativeDistance) {
+  EXPECT_EQ(materialSlot({0.1, -0.2, -0.3, 0.4}, 4), 1);
+  EXPECT_EQ(materialSlot({0.1, 0.2, -0.3, 0.4}, 2), -1);  // slot 2 is not in use
+  EXPECT_EQ(materialSlot({-0.1, -0.2, 0.3, 0.4}, 4), 0);
+}
+
+}  // namespace
+}  // namespace eik

@@ -1,0 +1,89 @@
+// Receiver maps on disk (receiver_map.h, volume.h): written beside the fields as oriented NRRDs,
+// listed in the manifest, read back exactly; malformed entries named.
+#include "core/receiver_map.h"
+
+#include <gtest/gtest.h>
+
+#include "core/testing.h"
+#include "core/volume.h"
+
+namespace eik {
+namespace {
+
+using test_support::inputErrorOf;
+using test_support::TempDir;
+
+ReceiverMap sampleMap() {
+  ReceiverMap map;
+  map.point = {0.0, -0.5, 0.0};
+  receiverAxes(map.normal, map.u, map.v);
+  map.origin = {-1.0, -0.75};
+  map.pitch = 0.25;
+  map.texels = {8, 6};
+  map.irradiance.resize(map.texelCount() * 3);
+  for (std::size_t i = 0; i < map.irradiance.size(); ++i) map.irradiance[i] = 0.5f * static_cast<float>(i);
+  return map;
+}
+
+TEST(ReceiverMap, AxesAreOrthonormalWithUCrossVTheNormal) {
+  for (const glm::dvec3 n : {glm::dvec3(0, 1, 0), glm::normalize(glm::dvec3(0.3, 1, -0.2)), glm::dvec3(0, 0, -1)}) {
+    glm::dvec3 u, v;
+    receiverAxes(n, u, v);
+    EXPECT_NEAR(glm::dot(u, n), 0.0, 1e-12);
+    EXPECT_NEAR(glm::length(u), 1.0, 1e-12);
+    EXPECT_NEAR(glm::length(glm::cross(u, v) - n), 0.0, 1e-12);
+  }
+}
+
+TEST(ReceiverMap, TexelCentresAndPlaneCoordinatesAgree) {
+  const ReceiverMap map = sampleMap();
+  const glm::dvec3 c = map.texelCenter(2, 3);
+  EXPECT_NEAR(c.y, -0.5, 1e-12);
+  const glm::dvec2 uv = map.planeCoordinates(c);
+  EXPECT_NEAR(uv.x, -1.0 + 2.5 * 0.25, 1e-12);
+  EXPECT_NEAR(uv.y, -0.75 + 3.5 * 0.25, 1e-12);
+}
+
+TEST(ReceiverMap, RoundTripsThroughAVolume) {
+  TempDir dir;
+  Volume v;
+  v.grid.dims = {2, 2, 2};
+  v.grid.bounds_max = glm::dvec3(1.0);
+  v.addField("ior", 1);
+  v.receivers.push_back(sampleMap());
+  writeVolume(v, dir / "r.vol.json");
+  EXPECT_TRUE(std::filesystem::exists(dir / "r.receiver-ground.nrrd"));
+  const Volume back = readVolume(dir / "r.vol.json");
+  ASSERT_EQ(back.receivers.size(), 1u);
+  const ReceiverMap& m = back.receivers[0];
+  EXPECT_EQ(m.texels, glm::ivec2(8, 6));
+  EXPECT_EQ(m.irradiance, sampleMap().irradiance);
+  EXPECT_NEAR(glm::length(m.v - sampleMap().v), 0.0, 1e-12);
+  // The NRRD stands where the plane is: origin at texel (0, 0)'s centre, axes pitch·u, pitch·v.
+  const NrrdHeader h = readNrrdHeader(dir / "r.receiver-ground.nrrd");
+  EXPECT_NEAR(glm::length(h.origin - sampleMap().texelCenter(0, 0)), 0.0, 1e-9);
+  EXPECT_NEAR(glm::length(h.directions[1] - 0.25 * sampleMap().v), 0.0, 1e-12);
+  EXPECT_FALSE(readVolumeHeader(dir / "r.vol.json").receivers.empty());
+}
+
+TEST(ReceiverMap, MalformedEntriesNameTheKey) {
+  std::string file;
+  nlohmann::json good = sampleMap().toJson("x.nrrd");
+  EXPECT_NO_THROW(receiverFromJson(good, "v.json", "receivers[0]", file));
+  EXPECT_EQ(file, "x.nrrd");
+  nlohmann::json bad = good;
+  bad["pitch"] = -1;
+  EXPECT_CONTAINS(inputErrorOf([&] { receiverFromJson(bad, "v.json", "receivers[0]", file); }), "receivers[0].pitch");
+  bad = good;
+  bad["u"] = {0, 1, 0};
+  EXPECT_CONTAINS(inputErrorOf([&] { receiverFromJson(bad, "v.json", "receivers[0]", file); }), "u × v = normal");
+  bad = good;
+  bad["texels"] = {0, 4};
+  EXPECT_CONTAINS(inputErrorOf([&] { receiverFromJson(bad, "v.json", "receivers[0]", file); }), "receivers[0].texels");
+  bad = good;
+  bad.erase("origin");
+  EXPECT_CONTAINS(inputErrorOf([&] { receiverFromJson(bad, "v.json", "receivers[0]", file); }), "receivers[0].origin: missing");
+}
+
+}  // namespace
+}  // namespace eik

@@ -1,0 +1,102 @@
+// Receiver maps (receiver.h): the exact clipping of footprints against texels, the footprint of a
+// patch on the plane, and the map's layout.
+#include "lightsim/receiver.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numeric>
+
+#include "core/error.h"
+#include "lightsim/test_scenes.h"
+#include "lightsim/wavefront.h"
+
+namespace eik {
+namespace {
+
+TEST(Receiver, TriangleSquareOverlapIsExact) {
+  // The whole triangle inside, the square inside the triangle, and a half cut.
+  EXPECT_NEAR(triangleSquareOverlap({0.2, 0.2}, {0.8, 0.2}, {0.2, 0.8}, {0, 0}, {1, 1}), 0.18, 1e-15);
+  EXPECT_NEAR(triangleSquareOverlap({-5, -5}, {10, -5}, {-5, 10}, {0, 0}, {1, 1}), 1.0, 1e-15);
+  EXPECT_NEAR(triangleSquareOverlap({0, 0}, {2, 0}, {0, 2}, {0, 0}, {1, 1}), 1.0, 1e-15);
+  EXPECT_NEAR(triangleSquareOverlap({0, 0}, {1, 0}, {0, 1}, {0, 0}, {1, 1}), 0.5, 1e-15);
+  EXPECT_NEAR(triangleSquareOverlap({2, 2}, {3, 2}, {2, 3}, {0, 0}, {1, 1}), 0.0, 1e-15);
+  // Winding does not matter.
+  EXPECT_NEAR(triangleSquareOverlap({0, 0}, {0, 1}, {1, 0}, {0, 0}, {1, 1}), 0.5, 1e-15);
+}
+
+ReceiverMap unitMap(int texels, double pitch) {
+  ReceiverMap map;
+  map.origin = glm::dvec2(-0.5 * texels * pitch);
+  map.pitch = pitch;
+  map.texels = glm::ivec2(texels);
+  return map;
+}
+
+TEST(Receiver, FootprintFluxIsConservedAndSpreadByArea) {
+  const ReceiverMap map = unitMap(16, 0.1);
+  std::vector<glm::dvec3> flux(map.texelCount(), glm::dvec3(0.0));
+  // A tilted quad inside the map.
+  const std::array<glm::dvec2, 4> quad{{{-0.33, -0.21}, {0.41, -0.29}, {0.37, 0.52}, {-0.28, 0.44}}};
+  depositFootprint(map, quad, glm::dvec3(2.0, 1.0, 0.5), flux);
+  const glm::dvec3 total = std::accumulate(flux.begin(), flux.end(), glm::dvec3(0.0));
+  EXPECT_NEAR(total.x, 2.0, 1e-12);
+  EXPECT_NEAR(total.z, 0.5, 1e-12);
+  // A texel wholly inside gets flux × texel area / quad area.
+  const double area = 0.5 * std::abs((quad[2].x - quad[0].x) * (quad[3].y - quad[1].y) -
+                                     (quad[3].x - quad[1].x) * (quad[2].y - quad[0].y));
+  const std::size_t centre = 8 * 16 + 8;  // texel [0, 0.1]²
+  EXPECT_NEAR(flux[centre].x, 2.0 * 0.01 / area, 1e-12);
+  // Flux outside the map is dropped, the rest kept.
+  std::vector<glm::dvec3> edge(map.texelCount(), glm::dvec3(0.0));
+  depositFootprint(map, {{{0.7, 0.7}, {0.9, 0.7}, {0.9, 0.9}, {0.7, 0.9}}}, glm::dvec3(1.0), edge);
+  EXPECT_NEAR(std::accumulate(edge.begin(), edge.end(), glm::dvec3(0.0)).x, 0.25, 1e-12);
+}
+
+TEST(Receiver, FootprintsThatTileThePlaneGiveEveryTexelItsShare) {
+  const ReceiverMap map = unitMap(20, 0.05);
+  std::vector<glm::dvec3> flux(map.texelCount(), glm::dvec3(0.0));
+  // A lattice of parallelograms of 0.073 × 0.061, sheared, over the whole map, E = 3.
+  const double a = 0.073, b = 0.061, shear = 0.02;
+  for (int j = -20; j < 20; ++j)
+    for (int i = -20; i < 20; ++i) {
+      auto at = [&](int u, int v) { return glm::dvec2(u * a + v * shear, v * b); };
+      depositFootprint(map, {{at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)}}, glm::dvec3(3.0 * a * b), flux);
+    }
+  for (std::size_t t = 0; t < map.texelCount(); ++t) ASSERT_NEAR(flux[t].x / (0.05 * 0.05), 3.0, 1e-9) << t;
+}
+
+TEST(Receiver, APatchsFootprintFollowsItsCornerRays) {
+  ReceiverMap map = unitMap(8, 0.1);
+  Patch p;
+  p.x = {glm::dvec3(0, 1, 0), glm::dvec3(0.1, 1, 0), glm::dvec3(0.1, 1, 0.1), glm::dvec3(0, 1, 0.1)};
+  const glm::dvec3 d = glm::normalize(glm::dvec3(1, -1, 0));
+  for (auto& w : p.w) w = d;
+  std::array<glm::dvec2, 4> f;
+  ASSERT_TRUE(patchFootprint(p, map, f));
+  // Each corner moves 1 along +x on its way down to y = 0: u = x + 1, v = z (the map's default axes).
+  EXPECT_NEAR(f[0].x, 1.0, 1e-12);
+  EXPECT_NEAR(f[1].x, 1.1, 1e-12);
+  EXPECT_NEAR(f[2].y, 0.1, 1e-12);
+  for (auto& w : p.w) w = glm::dvec3(1, 0, 0);
+  EXPECT_FALSE(patchFootprint(p, map, f));  // parallel to the plane
+}
+
+TEST(Receiver, TheMapCoversTheShadowAndOneShadowSizeAround) {
+  const GridSpec g = test_scenes::cubicGrid(10, 0.5);
+  ReceiverSpec spec;
+  spec.point = {0, -1, 0};
+  LightSpec light;  // straight down
+  const ReceiverMap map = receiverGeometry(spec, light, g, g.bounds_min, g.bounds_max);
+  // The shadow is [−0.5, 0.5]²; grown by 1 on every side: [−1.5, 1.5]², texels of h/4 = 0.025.
+  EXPECT_NEAR(map.origin.x, -1.5, 1e-12);
+  EXPECT_NEAR(map.pitch, 0.025, 1e-12);
+  EXPECT_EQ(map.texels, glm::ivec2(120));
+  spec.half_extent = 0.7;
+  EXPECT_EQ(receiverGeometry(spec, light, g, g.bounds_min, g.bounds_max).texels, glm::ivec2(56));
+  light.direction = {0, 1, 0};  // from below: the plane's back
+  EXPECT_THROW(receiverGeometry(spec, light, g, g.bounds_min, g.bounds_max), InputError);
+}
+
+}  // namespace
+}  // namespace eik

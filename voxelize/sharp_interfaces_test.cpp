@@ -1,0 +1,105 @@
+// Sharp interfaces from the voxeliser (sharp_interfaces.h): the slots, the distances, n unblended,
+// ∇n of graded materials only.
+#include "voxelize/sharp_interfaces.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/testing.h"
+#include "voxelize/grid_builder.h"
+#include "voxelize/pipeline.h"
+#include "voxelize/procedural.h"
+
+namespace eik {
+namespace {
+
+using test_support::inputErrorOf;
+
+std::vector<Region> regionsOf(const std::vector<std::string>& specs, const GridSpec& grid) {
+  ProceduralOptions options;
+  options.distance_band = interfaceBand(grid);
+  std::vector<Region> regions;
+  for (const std::string& s : specs)
+    for (Region& r : voxelizeProcedural(parseProceduralSpec(s), grid, options)) regions.push_back(std::move(r));
+  return regions;
+}
+
+GridSpec cube(int res, double half) {
+  GridSpec g;
+  g.dims = glm::ivec3(res);
+  g.bounds_min = glm::dvec3(-half);
+  g.bounds_max = glm::dvec3(half);
+  return g;
+}
+
+TEST(SharpInterfaces, SlotsAreMaterialsInnermostFirst) {
+  const GridSpec g = cube(24, 0.6);
+  // Wine inside glass; a second glass object merges with the first; smoke (n = 1) around all of it
+  // needs no slot; two opaque grains share one.
+  const auto regions = regionsOf({"procedural:sphere,r=0.5,ior=1.5", "procedural:sphere,r=0.2,ior=1.33,name=wine",
+                                  "procedural:box,size=0.1,center=0.3:0.3:0.3,ior=1.5,name=chip",
+                                  "procedural:sphere,r=0.05,center=-0.2:0:0,albedo=0.1:0.1:0.1,name=grain",
+                                  "procedural:sphere,r=0.04,center=0.2:0:0,albedo=0.2:0.2:0.2,name=grain",
+                                  "procedural:box,size=1.1,ior=1,scatter=0.3,name=smoke"},
+                                 g);
+  const SlotAssignment slots = assignInterfaceSlots(regions, interfaceBand(g));
+  ASSERT_EQ(slots.table.slots.size(), 3u);
+  EXPECT_TRUE(slots.table.slots[0].opaque);        // the grains, smallest
+  // n = 1.5: the chip, smaller than the wine, comes first and names the slot it shares with the sphere.
+  EXPECT_EQ(slots.table.slots[1].name, "chip");
+  EXPECT_EQ(slots.table.slots[2].name, "wine");
+  EXPECT_EQ(slots.slot_of_region[2], slots.slot_of_region[0]);  // chip and sphere: one glass
+  EXPECT_EQ(slots.slot_of_region[5], -1);                        // the smoke
+}
+
+TEST(SharpInterfaces, MoreThanFourMaterialsIsAnErrorNamingThem) {
+  const GridSpec g = cube(12, 1.0);
+  std::vector<std::string> specs;
+  for (int i = 0; i < 5; ++i)
+    specs.push_back("procedural:sphere,r=0.1,center=" + std::to_string(-0.8 + 0.4 * i) + ":0:0,ior=" +
+                    std::to_string(1.3 + 0.1 * i) + ",name=m" + std::to_string(i));
+  const auto regions = regionsOf(specs, g);
+  EXPECT_CONTAINS(inputErrorOf([&] { assignInterfaceSlots(regions, 0.1); }), "5 distinct materials");
+}
+
+TEST(SharpInterfaces, FieldsAreSharpDistancesAndUnblendedN) {
+  const GridSpec g = cube(32, 0.6);
+  const Volume v = buildSharpVolume(regionsOf({"procedural:sphere,r=0.5,ior=1.5"}, g), g, interfaceBand(g));
+  const Field& d = v.fields.at("interfaces");
+  const Field& n = v.fields.at("ior");
+  const Field& grad = v.fields.at("ior_grad");
+  for (int k = 0; k < 32; ++k)
+    for (int j = 0; j < 32; ++j)
+      for (int i = 0; i < 32; ++i) {
+        const std::size_t at = g.index(i, j, k);
+        const double r = glm::length(g.center(i, j, k));
+        const double band = interfaceBand(g);
+        // The exact distance of a sphere, within the band; +band beyond; unused slots +band.
+        ASSERT_NEAR(d.voxel(at)[0], std::clamp(r - 0.5, -band, band), 1e-6);
+        ASSERT_FLOAT_EQ(d.voxel(at)[1], static_cast<float>(band));
+        ASSERT_FLOAT_EQ(n.data[at], r < 0.5 ? 1.5f : 1.0f);  // no blending at the surface
+        ASSERT_EQ(grad.voxel(at)[0], 0.0f);
+      }
+  EXPECT_EQ(v.metadata.at("interfaces").at("slots").size(), 1u);
+  EXPECT_EQ(v.metadata.at("ior_smoothing_sigma_voxels"), 0.0);
+}
+
+TEST(SharpInterfaces, AGradedLensKeepsItsOwnNAndGradientAcrossTheSurface) {
+  const GridSpec g = cube(32, 0.6);
+  const Volume v = buildSharpVolume(regionsOf({"procedural:gradient_slab,size=0.8:0.8:0.8,n0=1.3,n1=1.7"}, g), g,
+                                    interfaceBand(g));
+  ASSERT_TRUE(interfaceTable(v).slots.at(0).graded);
+  // n rises by 0.4 over 0.8 along x: ∇n = (0.5, 0, 0) inside and just outside (continued), no jump.
+  const Field& grad = v.fields.at("ior_grad");
+  for (int i = 2; i < 30; ++i) {
+    const std::size_t at = g.index(i, 16, 16);
+    if (std::abs(g.center(i, 16, 16).x) > 0.4 + 2 * g.voxelSize().x) continue;
+    EXPECT_NEAR(grad.voxel(at)[0], 0.5, 1e-4) << i;
+    EXPECT_NEAR(grad.voxel(at)[1], 0.0, 1e-6) << i;
+  }
+  EXPECT_NEAR(v.fields.at("ior").data[g.index(16, 16, 16)], 1.5 + 0.5 * g.center(16, 16, 16).x, 1e-5);
+}
+
+}  // namespace
+}  // namespace eik
