@@ -230,6 +230,24 @@ void enterSharpFace@(inout Ray r, inout March@ m) {
 #endif
 }
 
+// The light along the branch a sharp face does not follow (volume-space point and direction): it
+// goes straight from the face, so it meets the ground (GROUND) where it heads down onto it (a face
+// resting on the ground sends its light there, not into the sky below the horizon), and the
+// environment otherwise.
+vec3 branchRadiance@(vec3 pVol, vec3 dVol) {
+  vec3 dw = normalize(mat3(uObjVolToWorld[@]) * dVol);
+#ifdef GROUND
+  vec3 pw = (uObjVolToWorld[@] * vec4(pVol, 1.0)).xyz;
+  float down = -dot(dw, uGroundNormal);
+  if (down > 0.0) {
+    // A face a hair under the ground (its surface is found to a fraction of a voxel) meets it here.
+    vec3 hit = pw + dw * (max(dot(pw - uGroundPoint, uGroundNormal), 0.0) / down);
+    if (onGround(hit)) return groundRadiance(hit);
+  }
+#endif
+  return environmentRadiance(dw, uReflectionLod);
+}
+
 // The ray ends on the ground (GROUND) where the last step crossed it from above inside the volume
 // (checked before leaving the box, as the last step may do both): ρE/π there. True when it did.
 bool hitGround@(inout Ray r, inout March@ m) {
@@ -517,13 +535,13 @@ bool crossInterface@(inout Ray r, inout March@ m, float cauchy) {
   float R = fresnelUnpolarised(n1, n2, cosI, sqrt(1.0 - sin2T));
   vec3 weight = r.T * exp(-m.tau);
   if (R > 0.5) {
-    r.radiance += weight * (1.0 - R) * environmentRadiance(normalize(mat3(uObjVolToWorld[@]) * refracted), uReflectionLod);
+    r.radiance += weight * (1.0 - R) * branchRadiance@(p, refracted);
     r.T *= R;
     m.w = mirrored * n1;
     m.n = n1;
     return false;
   }
-  r.radiance += weight * R * environmentRadiance(normalize(mat3(uObjVolToWorld[@]) * mirrored), uReflectionLod);
+  r.radiance += weight * R * branchRadiance@(p, mirrored);
   r.T *= 1.0 - R;
 #endif
   m.w = refracted * n2;
