@@ -250,8 +250,15 @@ vec3 branchRadiance@(vec3 pVol, vec3 dVol) {
 
 // The ray ends on the ground (GROUND) where the last step crossed it from above inside the volume
 // (checked before leaving the box, as the last step may do both): ρE/π there. True when it did.
+// With sharp interfaces the ground is met from the air only: inside a material the height is not
+// followed, so a face resting on the ground decides first (Fresnel, total internal reflection) and
+// the ray meets the ground once it has left the face downwards; the face is found to a fraction of
+// a voxel, a hair above or below the plane, which must not decide whether a reflection happens.
 bool hitGround@(inout Ray r, inout March@ m) {
 #ifdef GROUND
+#ifdef HAS_INTERFACES
+  if (m.medium >= 0) return false;
+#endif
   float s = dot(m.x - m.groundPoint, m.groundNormal);
   if (m.side > 0.0 && s <= 0.0) {
     vec3 hit = mix(m.xPrev, m.x, m.side / (m.side - s));
