@@ -45,6 +45,8 @@ struct March@ {
   float side;       // height above the ground at the last sample
   vec3 xPrev;       // position at the last sample
   int medium;       // sharp interfaces (HAS_INTERFACES): the material slot the ray is in, −1 air
+  vec4 dist;        // the slot distances fetched last (HAS_INTERFACES) ...
+  vec3 xDist;       // ... and where: a step reuses them at its start instead of fetching again
 };
 
 // Radiance of an opaque embedding of diffuse albedo ρ at uvw: ρE/π with the baked irradiance E
@@ -181,7 +183,9 @@ March@ enterVolume@(Ray r, float cauchy) {
   m.h = uObjStep[@];
   vec3 d = normalize(mat3(toVolume) * r.d);
   m.x = (toVolume * vec4(r.x, 1.0)).xyz + d * (1e-3 * m.h);
-  m.medium = materialAt@(volumeInterfaces((m.x - m.bmin) * m.invExtent));
+  m.dist = volumeInterfaces((m.x - m.bmin) * m.invExtent);
+  m.xDist = m.x;
+  m.medium = materialAt@(m.dist);
   vec4 optics = refractiveIndex@((m.x - m.bmin) * m.invExtent, cauchy, m.medium);
   m.n = optics.r;
   m.w = d * m.n;
@@ -412,7 +416,7 @@ void inScatter@(inout Ray r, March@ m, vec3 uvw, float hs) {
 float stepLength@(March@ m, vec3 uvw, float grad2) {
   bool quiet = grad2 <= m.quiet2;
 #ifdef HAS_INTERFACES
-  vec4 d = abs(volumeInterfaces(uvw));
+  vec4 d = abs(all(equal(m.x, m.xDist)) ? m.dist : volumeInterfaces(uvw));
   float nearest = min(min(d.x, d.y), min(d.z, d.w));
   quiet = quiet && nearest > 4.0 * m.h;
 #endif
@@ -457,10 +461,12 @@ void stepRay@(inout March@ m, vec3 grad, float hs, float cauchy) {
 bool crossInterface@(inout Ray r, inout March@ m, float cauchy) {
 #ifdef HAS_INTERFACES
   vec3 x0 = m.xStepStart, x1 = m.x;
-  vec4 d0 = volumeInterfaces((x0 - m.bmin) * m.invExtent);
   vec4 d1 = volumeInterfaces((x1 - m.bmin) * m.invExtent);
+  m.dist = d1;
+  m.xDist = x1;
   int next = materialAt@(d1);
-  if (next == m.medium) return false;
+  if (next == m.medium) return false;  // most steps: one fetch
+  vec4 d0 = volumeInterfaces((x0 - m.bmin) * m.invExtent);
   // Where each slot's distance changes sign along the chord; then, in order along it, the first
   // surface that changes the material (an outer slot's surface inside an inner one changes nothing).
   vec4 f = vec4(2.0);
