@@ -17,13 +17,12 @@
 #include "core/image_io.h"
 #include "core/testing.h"
 #include "core/volume.h"
-#include "gl/context.h"
-#include "gl/shader_library.h"
 #include "lightsim/bake.h"
 #include "lightsim/cpu_simulator.h"
 #include "tests/reference/exact_optics.h"
 #include "viewer/environment.h"
 #include "viewer/loaded_scene.h"
+#include "viewer/gl_test_fixture.h"
 #include "viewer/scene_renderer.h"
 
 namespace eik {
@@ -89,16 +88,8 @@ Volume smoothedVolume(const SignedDistance& region, double n1, glm::dvec3 sigma_
   return v;
 }
 
-class SceneRendererTest : public ::testing::Test {
+class SceneRendererTest : public GlSuiteTest {
  protected:
-  static void SetUpTestSuite() {
-    context_ = std::make_unique<gl::GlContext>();
-    shaders_ = std::make_unique<gl::ShaderLibrary>();
-  }
-  static void TearDownTestSuite() {
-    shaders_.reset();
-    context_.reset();
-  }
 
   static LoadedScene oneObject(Volume volume, const std::string& env, const SceneObjectSpec& placement = {}) {
     Scene scene;
@@ -119,8 +110,6 @@ class SceneRendererTest : public ::testing::Test {
     writeImage(std::filesystem::temp_directory_path() / ("eikonal-viewer-" + name + ".png"), image);
   }
 
-  static inline std::unique_ptr<gl::GlContext> context_;
-  static inline std::unique_ptr<gl::ShaderLibrary> shaders_;
 };
 
 Camera lookAt(glm::dvec3 eye, glm::dvec3 target, double fov_deg, glm::dvec3 up = {0, 1, 0}) {

@@ -8,13 +8,12 @@
 #include <numbers>
 
 #include "core/image_io.h"
-#include "gl/context.h"
-#include "gl/shader_library.h"
 #include "lightsim/cpu_simulator.h"
 #include "lightsim/bake.h"
 #include "lightsim/test_scenes.h"
 #include "tests/reference/exact_optics.h"
 #include "viewer/loaded_scene.h"
+#include "viewer/gl_test_fixture.h"
 #include "viewer/scene_renderer.h"
 
 namespace eik {
@@ -23,16 +22,8 @@ namespace {
 using test_scenes::box;
 using test_scenes::sharpVolume;
 
-class SharpViewerTest : public ::testing::Test {
+class SharpViewerTest : public GlSuiteTest {
  protected:
-  static void SetUpTestSuite() {
-    context_ = std::make_unique<gl::GlContext>();
-    shaders_ = std::make_unique<gl::ShaderLibrary>();
-  }
-  static void TearDownTestSuite() {
-    shaders_.reset();
-    context_.reset();
-  }
   static LoadedScene oneObject(Volume volume) {
     Scene scene;
     scene.objects.push_back({});
@@ -41,8 +32,6 @@ class SharpViewerTest : public ::testing::Test {
     loaded.scene.environment.uniform = glm::dvec3(1.0);
     return loaded;
   }
-  static inline std::unique_ptr<gl::GlContext> context_;
-  static inline std::unique_ptr<gl::ShaderLibrary> shaders_;
 };
 
 Camera lookAlong(const glm::dvec3& eye, const glm::dvec3& dir, double fov_deg, const glm::dvec3& up = {0, 1, 0}) {
