@@ -13,9 +13,11 @@ const char* depositDefine(DepositMode mode) { return mode == DepositMode::Max ? 
 }  // namespace
 
 AnalysisPass::AnalysisPass(const gl::ShaderLibrary& library, DepositMode mode, const AtlasLayout& atlas,
-                           const std::string& volumeDefines) {
+                           const std::string& volumeDefines, bool track, bool receiver) {
   gl::ShaderDefines defines = atlas.defines();
   defines.emplace_back(depositDefine(mode), "1");
+  if (track) defines.emplace_back("DEPOSIT_TRACK", "1");
+  if (receiver) defines.emplace_back("RECEIVER", "1");
   program_ = library.program("common/fullscreen.vert", "lightsim/analysis.frag", defines, volumeDefines);
 }
 
@@ -42,6 +44,11 @@ void AnalysisPass::run(const PatchTextures& current, const PatchTextures& previo
   program_.set("uMaxDepth", step.maxDepth);
   program_.set("uAxisSplit", step.axisSplit);
   program_.set("uKillAtMaxDepth", step.killAtMaxDepth);
+  program_.set("uBoxMin", step.boxMin);
+  program_.set("uBoxMax", step.boxMax);
+  program_.set("uBounces", step.bounces);
+  program_.set("uReceiverPoint", step.receiverPoint);
+  program_.set("uReceiverNormal", step.receiverNormal);
   triangle_.draw();
   gl::checkErrors("AnalysisPass");
 }

@@ -35,9 +35,11 @@ namespace eik::gpu {
 
 class AnalysisPass {
  public:
-  // volumeDefines: as for UpdatePass.
+  // volumeDefines: as for UpdatePass. `track`: the deposit records of track-length deposits
+  // (DEPOSIT_TRACK, track_deposit_pass.h) instead of the midpoint's; `receiver`: patches reaching
+  // the receiver plane of StepUniforms are received (RECEIVER).
   AnalysisPass(const gl::ShaderLibrary& library, DepositMode mode, const AtlasLayout& atlas,
-               const std::string& volumeDefines);
+               const std::string& volumeDefines, bool track = false, bool receiver = false);
   void run(const PatchTextures& current, const PatchTextures& previous, std::size_t count, StepTargets& targets,
            const gl::VolumeTextures& volume, const GridUniforms& grid, const StepUniforms& step) const;
 

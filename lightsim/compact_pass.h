@@ -33,8 +33,9 @@ class CompactPass {
   // pyramidDefines: HistoPyramid::defines() of the pyramids it will read (their levels).
   CompactPass(const gl::ShaderLibrary& library, const gl::ShaderDefines& pyramidDefines,
               const std::string& volumeDefines);
+  // dt: Δt (with sharp interfaces the reach of a followed reflection, sharp.glsl reflectedPatch).
   void run(const PatchTextures& in, const StepTargets& targets, PatchTextures& out, std::size_t total,
-           const gl::VolumeTextures& volume, const GridUniforms& grid) const;
+           const gl::VolumeTextures& volume, const GridUniforms& grid, float dt = 0.0f) const;
 
  private:
   gl::Program program_;

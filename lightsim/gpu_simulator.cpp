@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <map>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "core/error.h"
@@ -24,6 +25,7 @@
 #include "lightsim/ledger_pass.h"
 #include "lightsim/list_set.h"
 #include "lightsim/patch_textures.h"
+#include "lightsim/receiver.h"
 #include "lightsim/step_uniforms.h"
 #include "lightsim/update_pass.h"
 #include "lightsim/wavefront.h"
@@ -42,7 +44,7 @@ std::string bytesText(std::size_t bytes) {
 Volume simulationFields(const Volume& volume) {
   Volume v;
   v.grid = volume.grid;
-  for (const char* name : {"ior", "ior_grad", "sigma_a"}) {
+  for (const char* name : {"ior", "ior_grad", "sigma_a", "interfaces"}) {
     if (const Field* f = volume.find(name)) v.fields[name] = *f;
   }
   return v;
@@ -57,6 +59,7 @@ struct GpuSimulator::Impl {
   AtlasLayout atlasLayout;  // planned (and the memory checked) before anything is uploaded
   int maxSide = 0;
   VolumeSampler sampler;    // the CPU twin's sampler, for initialPatches
+  bool sharp = false;       // the volume has sharp interfaces (SHARP_INTERFACES in the passes)
   gl::ShaderLibrary library;
   gl::VolumeTextures volume;
   std::string volumeDefines;
@@ -69,7 +72,7 @@ struct GpuSimulator::Impl {
   // Programs, made on first use and kept across runs.
   std::map<Integrator, std::unique_ptr<gpu::UpdatePass>> updates;
   std::map<DepositMode, std::unique_ptr<gpu::DepositPass>> deposits;
-  std::map<DepositMode, std::unique_ptr<gpu::AnalysisPass>> analyses;
+  std::map<std::tuple<DepositMode, bool, bool>, std::unique_ptr<gpu::AnalysisPass>> analyses;
   std::map<int, std::unique_ptr<gpu::CompactPass>> compacts;  // by pyramid levels
   std::unique_ptr<gpu::LedgerPass> ledger;
 
@@ -80,10 +83,12 @@ struct GpuSimulator::Impl {
         atlasLayout(planAtlas(v, o)),
         maxSide(patchListLimit(o)),
         sampler(v),
+        sharp(sampler.sharp()),
         volume(uploadVolume(v, o)),
-        volumeDefines(volume.layout().glslDefines() + (o.exact_sampling ? "#define EXACT_TRILINEAR 1\n" : "")),
+        volumeDefines(volume.layout().glslDefines() + (o.exact_sampling ? "#define EXACT_TRILINEAR 1\n" : "") +
+                      (sharp ? "#define SHARP_INTERFACES 1\n" : "")),
         origin(0.5 * (grid.bounds_min + grid.bounds_max)),
-        gridUniforms(gpu::GridUniforms::from(localGrid(grid, origin))) {}
+        gridUniforms(gpu::GridUniforms::from(localGrid(grid, origin), interfaceTable(v, o.source))) {}
 
   static GridSpec localGrid(GridSpec g, const glm::dvec3& origin) {
     g.bounds_min -= origin;
@@ -100,7 +105,8 @@ struct GpuSimulator::Impl {
                                                  context.info().renderer);
     // Optics (n, ∇n) RGBA32F, absorption (σa) RGB32F: gl/volume_textures.h.
     const std::size_t fields =
-        v.grid.count() * ((v.has("ior") || v.has("ior_grad") ? 16 : 0) + (v.has("sigma_a") ? 12 : 0));
+        v.grid.count() *
+        ((v.has("ior") || v.has("ior_grad") ? 16 : 0) + (v.has("sigma_a") ? 12 : 0) + (v.has("interfaces") ? 16 : 0));
     const std::size_t budget = o.budget_bytes ? o.budget_bytes : gl::defaultTextureBudget();
     const std::size_t needed = fields + AtlasTargets::bytesFor(layout, DepositMode::Max) + gpu::ListSet::bytesFor(64);
     if (needed > budget) {
@@ -141,9 +147,9 @@ struct GpuSimulator::Impl {
     if (!p) p = std::make_unique<gpu::DepositPass>(library, atlasLayout, m);
     return *p;
   }
-  gpu::AnalysisPass& analyse(DepositMode m) {
-    auto& p = analyses[m];
-    if (!p) p = std::make_unique<gpu::AnalysisPass>(library, m, atlasLayout, volumeDefines);
+  gpu::AnalysisPass& analyse(DepositMode m, bool track, bool receiver) {
+    auto& p = analyses[{m, track, receiver}];
+    if (!p) p = std::make_unique<gpu::AnalysisPass>(library, m, atlasLayout, volumeDefines, track, receiver);
     return *p;
   }
   gpu::CompactPass& compact(const HistoPyramid& pyramid) {
@@ -177,9 +183,6 @@ GpuSimulator::GpuSimulator(const Volume& volume, GpuSimulatorOptions options)
 
 GpuSimulator::GpuSimulator(const Volume& volume, GpuSimulatorOptions options, std::unique_ptr<gl::GlContext> context)
     : ownedContext_(std::move(context)) {
-  if (volume.has("interfaces"))
-    throw InputError(options.source, "fields.interfaces",
-                     "the GPU path does not do sharp interfaces yet: bake with the CPU twin (--backend cpu or auto)");
   if (ownedContext_ && gl::GlContext::current() != ownedContext_.get()) ownedContext_->makeCurrent();
   if (!ownedContext_ && !gl::GlContext::current()) {  // none given, none current: a headless one
     gl::ContextOptions co;
@@ -231,15 +234,31 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   bake.irradiance.components = 3;
   bake.light_dir.components = 3;
 
-  // Initialisation (§6.2.1) on the CPU, shared with the twin.
+  const bool track = options.deposit == DepositMode::Accumulate && options.deposit_kernel == DepositKernel::Track;
+  if (options.receiver && !track)
+    throw InputError("lightsim options", "receiver",
+                     "the GPU path makes receiver maps with track deposits only (deposit accumulate, kernel track)");
+  const PatchLayout layout = sharp ? PatchLayout::Sharp : PatchLayout::Smooth;
+
+  // Initialisation (§6.2.1) on the CPU, shared with the twin; the receiver's map geometry first
+  // (the initial patches cover it).
   Stopwatch phaseWatch;
+  glm::dvec3 boxLo, boxHi;
+  propagationBox(grid, options, boxLo, boxHi);
+  ReceiverMap receiver;
+  if (options.receiver) receiver = receiverGeometry(*options.receiver, light, grid, boxLo, boxHi);
   double fluxRef = 0.0;
-  const std::vector<Patch> initial = initialPatches(light, grid, sampler, options, &fluxRef);
+  const std::vector<Patch> initial =
+      initialPatches(light, grid, sampler, options, &fluxRef, options.receiver ? &receiver : nullptr);
   stats.initial_patches = initial.size();
   for (const Patch& p : initial) stats.flux_in += p.flux;
   if (initial.empty()) {  // the light misses the volume: an empty bake
     bake.irradiance.data.assign(voxels * 3, 0.0f);
     bake.light_dir.data.assign(voxels * 3, 0.0f);
+    if (options.receiver) {
+      receiver.irradiance.assign(receiver.texelCount() * 3, 0.0f);
+      bake.receivers.push_back(std::move(receiver));
+    }
     stats.phase_seconds["init"] = phaseWatch.seconds();
     if (options.progress) options.progress(1.0);
     info.wall_seconds = runWatch.seconds();
@@ -255,7 +274,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   for (std::size_t i = 0; i < initial.size(); ++i) {
     Patch local = initial[i];
     for (glm::dvec3& x : local.x) x -= origin;
-    packed[i] = packPatch(local);
+    packed[i] = packPatch(local, layout);
   }
 
   const int firstSide = std::min(maxSide, patchSideFor(initial.size(), 64));
@@ -268,7 +287,11 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   gpu::LedgerPass& ledger = ledgerFor();
   ledger.reset();
 
-  const gpu::StepUniforms step = gpu::StepUniforms::from(grid, options, fluxRef);
+  gpu::StepUniforms step = gpu::StepUniforms::from(localGrid(grid, origin), options, fluxRef);
+  if (options.receiver) {
+    step.receiverPoint = glm::vec3(receiver.point - origin);
+    step.receiverNormal = glm::vec3(receiver.normal);
+  }
   // E_ref of the max-mode depth mapping: a small irradiance, so that bright patches get depths near
   // 0 where Depth32F is most precise (largest initial E / 1000).
   double eRef = 0.0;
@@ -277,7 +300,8 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
 
   const gpu::UpdatePass& updatePass = update(options.integrator);
   const gpu::DepositPass& depositPass = deposit(options.deposit);
-  const gpu::AnalysisPass& analysisPass = analyse(options.deposit);
+  const gpu::AnalysisPass& analysisPass = analyse(options.deposit, track, options.receiver.has_value());
+  const bool extraLedger = sharp || options.receiver.has_value();
   stats.phase_seconds["init"] = phaseWatch.seconds();
 
   const int maxSteps = eik::maxSteps(grid, options);
@@ -291,7 +315,8 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     if (options.progress && totalIn > 0.0) {
       const glm::dvec4 retired = ledger.sum(gpu::kExited) + ledger.sum(gpu::kAbsorbed) +
                                  ledger.sum(gpu::kReflected) + ledger.sum(gpu::kKilledFlux) +
-                                 ledger.sum(gpu::kFolded) + ledger.sum(gpu::kKilledDepth);
+                                 ledger.sum(gpu::kFolded) + ledger.sum(gpu::kKilledDepth) +
+                                 ledger.sum(gpu::kReceived) + ledger.sum(gpu::kBlocked);
       options.progress(std::min(1.0, luminance(glm::dvec3(retired)) / totalIn));
     }
   };
@@ -309,7 +334,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     timer.start("deposit");
     depositPass.run(L.targets.depositA, L.targets.depositB, count, atlas, energyRef);
     timer.start("ledger");
-    ledger.addStep(L.targets, L.b, count);
+    ledger.addStep(L.targets, L.b, count, extraLedger);
     timer.start("pyramid");
     L.targets.pyramid.build(count);
     timer.stop();
@@ -341,13 +366,13 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
       timer.start("grow");
       auto grown = std::make_unique<gpu::ListSet>(side, library);
       timer.start("compact");
-      compact(L.targets.pyramid).run(L.b, L.targets, grown->a, total, volume, gridUniforms);
+      compact(L.targets.pyramid).run(L.b, L.targets, grown->a, total, volume, gridUniforms, step.dt);
       timer.stop();
       lists = std::move(grown);
       info.peak_patch_side = std::max(info.peak_patch_side, lists->side());
     } else if (total > 0) {
       timer.start("compact");
-      compact(L.targets.pyramid).run(L.b, L.targets, L.a, total, volume, gridUniforms);
+      compact(L.targets.pyramid).run(L.b, L.targets, L.a, total, volume, gridUniforms, step.dt);
       timer.stop();
     }
     count = static_cast<std::size_t>(total);
@@ -368,6 +393,12 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   stats.flux_killed =
       glm::dvec3(ledger.sum(gpu::kKilledFlux) + ledger.sum(gpu::kFolded) + ledger.sum(gpu::kKilledDepth));
   stats.flux_unfinished = glm::dvec3(ledger.sum(gpu::kUnfinished));
+  stats.kills.received = static_cast<std::uint64_t>(std::llround(ledger.sum(gpu::kReceived).w));
+  stats.kills.blocked = static_cast<std::uint64_t>(std::llround(ledger.sum(gpu::kBlocked).w));
+  stats.flux_received = glm::dvec3(ledger.sum(gpu::kReceived));
+  stats.flux_blocked = glm::dvec3(ledger.sum(gpu::kBlocked));
+  stats.reflections = static_cast<std::uint64_t>(std::llround(ledger.sum(gpu::kSpawned).w));
+  stats.rollbacks = static_cast<std::uint64_t>(std::llround(ledger.sum(gpu::kRolledBack).w));
 
   phaseWatch.restart();
   atlas.toFields(bake.irradiance, bake.light_dir);

@@ -11,8 +11,11 @@ namespace eik::gpu {
 
 LedgerPass::LedgerPass(const gl::ShaderLibrary& library, int rows)
     : rows_(std::max(1, rows)),
-      target_({kBins, rows_}, std::vector<gl::TextureFormat>(kLedgerColumns, gl::TextureFormat::RGBA32F)),
+      target_({kBins, rows_}, std::vector<gl::TextureFormat>(kMainColumns, gl::TextureFormat::RGBA32F)),
+      extraTarget_({kBins, rows_},
+                   std::vector<gl::TextureFormat>(kLedgerColumns - kMainColumns, gl::TextureFormat::RGBA32F)),
       step_(library.program("lightsim/ledger.vert", "lightsim/ledger.frag")),
+      extra_(library.program("lightsim/ledger.vert", "lightsim/ledger.frag", {{"LEDGER_EXTRA", "1"}})),
       unfinished_(library.program("lightsim/ledger.vert", "lightsim/ledger.frag", {{"LEDGER_UNFINISHED", "1"}})),
       vao_(gl::VertexArray::create()) {
   clear();
@@ -24,9 +27,22 @@ void LedgerPass::reset() {
   sums_ = {};
 }
 
-void LedgerPass::addStep(const StepTargets& targets, const PatchTextures& current, std::size_t count) {
+void LedgerPass::addStep(const StepTargets& targets, const PatchTextures& current, std::size_t count, bool extra) {
+  if (full()) flush();
+  if (extra && count > 0) {
+    draw(
+        extra_, extraTarget_,
+        [&] {
+          targets.ledgerA.bind(0);
+          extra_.setSampler("uLedgerA", 0);
+          current.texture(PatchTextures::kFlux).bind(2);
+          extra_.setSampler("uFlux", 2);
+        },
+        count);
+    --row_;  // the same row as the main entries below
+  }
   draw(
-      step_,
+      step_, target_,
       [&] {
         targets.ledgerA.bind(0);
         step_.setSampler("uLedgerA", 0);
@@ -40,7 +56,7 @@ void LedgerPass::addStep(const StepTargets& targets, const PatchTextures& curren
 
 void LedgerPass::addUnfinished(const PatchTextures& list, std::size_t count) {
   draw(
-      unfinished_,
+      unfinished_, target_,
       [&] {
         list.texture(PatchTextures::kFlux).bind(0);
         unfinished_.setSampler("uFlux", 0);
@@ -51,7 +67,7 @@ void LedgerPass::addUnfinished(const PatchTextures& list, std::size_t count) {
 void LedgerPass::flush() {
   if (row_ == 0) return;
   for (int c = 0; c < kLedgerColumns; ++c) {
-    const std::vector<float> data = target_.readRGBA(c);
+    const std::vector<float> data = c < kMainColumns ? target_.readRGBA(c) : extraTarget_.readRGBA(c - kMainColumns);
     const std::size_t used = static_cast<std::size_t>(row_) * kBins;  // rows from the bottom
     for (std::size_t i = 0; i < used; ++i) {
       sums_[static_cast<std::size_t>(c)] += glm::dvec4(data[i * 4], data[i * 4 + 1], data[i * 4 + 2], data[i * 4 + 3]);
@@ -62,15 +78,16 @@ void LedgerPass::flush() {
 }
 
 void LedgerPass::clear() {
-  for (int c = 0; c < kLedgerColumns; ++c) target_.clear(c, glm::vec4(0.0f));
+  for (int c = 0; c < kMainColumns; ++c) target_.clear(c, glm::vec4(0.0f));
+  for (int c = kMainColumns; c < kLedgerColumns; ++c) extraTarget_.clear(c - kMainColumns, glm::vec4(0.0f));
 }
 
 template <class Setup>
-void LedgerPass::draw(const gl::Program& program, Setup&& setup, std::size_t points) {
+void LedgerPass::draw(const gl::Program& program, gl::Framebuffer& target, Setup&& setup, std::size_t points) {
   if (full()) flush();
   if (points > 0) {
     gl::ScopedPassBindings unbind;
-    target_.bind();
+    target.bind();
     program.use();
     setup();
     program.set("uRow", row_);

@@ -41,6 +41,11 @@ enum LedgerColumn {
   kKilledDepth,
   kSplits,
   kUnfinished,
+  // The extra entries (receivers, sharp interfaces; addStep with extra = true):
+  kReceived,     // (Φ, count) that reached the receiver plane
+  kBlocked,      // (Φ, count) stopped by opaque surfaces
+  kSpawned,      // (0, count) reflected wavefronts followed
+  kRolledBack,   // (0, count) steps undone before a crossing
   kLedgerColumns
 };
 
@@ -57,8 +62,9 @@ class LedgerPass {
   // Zero sums and rows, for a new run.
   void reset();
 
-  // The entries of one step, from the analysis of the updated list `current`.
-  void addStep(const StepTargets& targets, const PatchTextures& current, std::size_t count);
+  // The entries of one step, from the analysis of the updated list `current`; `extra` adds the
+  // receiver and sharp-interface entries (kReceived ..) in a second draw.
+  void addStep(const StepTargets& targets, const PatchTextures& current, std::size_t count, bool extra = false);
   // The flux of the patches still alive at the end.
   void addUnfinished(const PatchTextures& list, std::size_t count);
 
@@ -71,12 +77,15 @@ class LedgerPass {
   void clear();
 
   template <class Setup>
-  void draw(const gl::Program& program, Setup&& setup, std::size_t points);
+  void draw(const gl::Program& program, gl::Framebuffer& target, Setup&& setup, std::size_t points);
 
+  static constexpr int kMainColumns = kReceived;  // in target_; the rest in extraTarget_
   int rows_;
   int row_ = 0;
   gl::Framebuffer target_;
+  gl::Framebuffer extraTarget_;
   gl::Program step_;
+  gl::Program extra_;
   gl::Program unfinished_;
   gl::VertexArray vao_;
   std::array<glm::dvec4, kLedgerColumns> sums_{};

@@ -22,18 +22,26 @@ int patchSideFor(std::size_t count, int minimum) {
   return side;
 }
 
-PatchTexels packPatch(const Patch& p) {
+PatchTexels packPatch(const Patch& p, PatchLayout layout) {
   PatchTexels t;
   for (std::size_t c = 0; c < 4; ++c) t[c] = glm::vec4(glm::vec3(p.x[c]), static_cast<float>(p.w[c].x));
   t[4] = glm::vec4(p.w[0].y, p.w[0].z, p.w[1].y, p.w[1].z);
   t[5] = glm::vec4(p.w[2].y, p.w[2].z, p.w[3].y, p.w[3].z);
   t[6] = glm::vec4(glm::vec3(p.flux), static_cast<float>(p.area0));
-  t[7] = glm::vec4(static_cast<float>(p.depth), static_cast<float>(p.n_in), static_cast<float>(p.cos_in),
-                   static_cast<float>(p.t_fresnel));
+  if (layout == PatchLayout::Sharp) {
+    int media = 0;
+    for (std::size_t c = 0; c < 4; ++c) media |= (p.medium[c] + 1) << (3 * c);
+    media |= p.crossed << 12;
+    t[7] = glm::vec4(static_cast<float>(p.depth + 64.0 * (std::min(p.reflections, 255) + 256 * p.bounce)),
+                     static_cast<float>(media), static_cast<float>(p.reflect_pending), static_cast<float>(p.t_fresnel));
+  } else {
+    t[7] = glm::vec4(static_cast<float>(p.depth), static_cast<float>(p.n_in), static_cast<float>(p.cos_in),
+                     static_cast<float>(p.t_fresnel));
+  }
   return t;
 }
 
-Patch unpackPatch(const PatchTexels& t) {
+Patch unpackPatch(const PatchTexels& t, PatchLayout layout) {
   Patch p;
   for (std::size_t c = 0; c < 4; ++c) p.x[c] = glm::dvec3(t[c]);
   p.w[0] = glm::dvec3(t[0].w, t[4].x, t[4].y);
@@ -42,6 +50,19 @@ Patch unpackPatch(const PatchTexels& t) {
   p.w[3] = glm::dvec3(t[3].w, t[5].z, t[5].w);
   p.flux = glm::dvec3(t[6]);
   p.area0 = t[6].w;
+  if (layout == PatchLayout::Sharp) {
+    const double rest = std::floor(static_cast<double>(t[7].x) / 64.0);
+    p.depth = static_cast<double>(t[7].x) - 64.0 * rest;
+    p.bounce = static_cast<int>(rest) / 256;
+    p.reflections = static_cast<int>(rest) - 256 * p.bounce;
+    const int media = static_cast<int>(std::lround(t[7].y));
+    for (std::size_t c = 0; c < 4; ++c) p.medium[c] = ((media >> (3 * c)) & 7) - 1;
+    p.crossed = (media >> 12) & 15;
+    p.reflect_pending = t[7].z;
+    const double event = std::floor(static_cast<double>(t[7].w) / 2.0);  // a stored list has none
+    p.t_fresnel = static_cast<double>(t[7].w) - 2.0 * event;
+    return p;
+  }
   p.depth = static_cast<double>(t[7].x);  // a multiple of ½, exact in float
   p.n_in = t[7].y;
   p.cos_in = t[7].z;

@@ -8,6 +8,9 @@
 //   5           W23      (w₂.y, w₂.z, w₃.y, w₃.z)
 //   6           FLUX     (Φ.rgb, A₀)
 //   7           META     (depth, n_in, cos_in, T_fresnel of the last step)
+//                        with sharp interfaces (PatchLayout::Sharp, SHARP_INTERFACES in GLSL):
+//                        (depth + 64·(reflections + 256·bounce), Σ (medium_c + 1)·8^c + 4096·crossed,
+//                         reflect_pending, T_fresnel + 2·event) — all integers exact in float
 //
 // Patch k lives at texel mortonTexel(k) (x from the even bits of k, y from the odd ones). That is
 // the order in which a histogram pyramid is descended with the child order (0,0), (1,0), (0,1),
@@ -43,10 +46,12 @@ void viewportLiveBox(std::size_t count);
 // The smallest power-of-two side whose square holds `count` patches (at least `minimum`).
 int patchSideFor(std::size_t count, int minimum = 1);
 
-// One patch as its eight texels (the layout above), and back (float ↔ double).
+// One patch as its eight texels (the layout above), and back (float ↔ double). The META texel
+// holds the boundary-layer state (Smooth) or the sharp-interface state (Sharp).
 using PatchTexels = std::array<glm::vec4, 8>;
-PatchTexels packPatch(const Patch& patch);
-Patch unpackPatch(const PatchTexels& texels);
+enum class PatchLayout { Smooth, Sharp };
+PatchTexels packPatch(const Patch& patch, PatchLayout layout = PatchLayout::Smooth);
+Patch unpackPatch(const PatchTexels& texels, PatchLayout layout = PatchLayout::Smooth);
 
 class PatchTextures {
  public:

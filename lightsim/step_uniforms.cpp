@@ -15,6 +15,11 @@ StepUniforms StepUniforms::from(const GridSpec& grid, const SimulationOptions& o
   step.maxDepth = static_cast<float>(options.max_depth);
   step.axisSplit = options.split_rule == SplitRule::Axis;
   step.killAtMaxDepth = options.at_max_depth == DepthLimit::Kill;
+  glm::dvec3 lo, hi;
+  propagationBox(grid, options, lo, hi);
+  step.boxMin = glm::vec3(lo);
+  step.boxMax = glm::vec3(hi);
+  step.bounces = options.bounces;
   return step;
 }
 

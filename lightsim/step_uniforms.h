@@ -4,6 +4,8 @@
 // pass (shaders/lightsim/fate.glsl, ALGORITHM.md step 5).
 #pragma once
 
+#include <glm/vec3.hpp>
+
 #include "core/grid.h"
 #include "lightsim/simulator.h"
 
@@ -17,9 +19,14 @@ struct StepUniforms {
   float maxDepth = 0.0f;                        // max_depth
   bool axisSplit = true;                        // SplitRule::Axis
   bool killAtMaxDepth = false;                  // DepthLimit::Kill
+  glm::vec3 boxMin{0.0f}, boxMax{0.0f};         // the propagation box (wavefront.h propagationBox)
+  int bounces = 0;                              // reflections followed (sharp interfaces)
+  // The receiver plane (RECEIVER in the analysis pass), in the grid's frame.
+  glm::vec3 receiverPoint{0.0f}, receiverNormal{0.0f, 1.0f, 0.0f};
 
   // The uniforms of a run of `options` on `grid`, whose largest initial patch flux is Φ_ref =
-  // fluxRef (initialPatches): Δt = timeStep, the split length splitThreshold (wavefront.h).
+  // fluxRef (initialPatches): Δt = timeStep, the split length splitThreshold, the box
+  // propagationBox (wavefront.h), in the frame of `grid` (GpuSimulator passes the grid-local one).
   static StepUniforms from(const GridSpec& grid, const SimulationOptions& options, double fluxRef);
 };
 

@@ -35,6 +35,9 @@ void UpdatePass::run(const PatchTextures& in, PatchTextures& out, std::size_t co
   program_.set("uDt", step.dt);
   program_.set("uBoundaryOn", step.boundaryOn);
   program_.set("uBoundaryOff", step.boundaryOff);
+  program_.set("uSplitLength", step.splitLength);  // sharp interfaces: tears
+  program_.set("uMaxDepth", step.maxDepth);
+  program_.set("uAxisSplit", step.axisSplit);
   triangle_.draw();
   gl::checkErrors("UpdatePass");
 }

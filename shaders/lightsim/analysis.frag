@@ -2,19 +2,37 @@
 // ALGORITHM.md step 5, analysis (thesis §6.2.4), and everything else a step needs per patch, in one
 // full-screen MRT pass over the updated list (fragment work runs on every core; the point passes
 // that follow only fetch its results):
-//   0 count        0, 1 or 4: the base of the histogram pyramid (step 6)
-//   1 deposit A    step 4 at the new midpoint m, in the voxel containing it (inside the grid only):
-//   2 deposit B      accumulate: A = (Φ·Δs_m/V_voxel, atlas x), B = (lum(Φ)·Δs_m·d, atlas y)
+//   0 count        slots of the new list: 0, 1, 2 or 4, + 1 for a followed reflection (the base
+//                  of the histogram pyramid, step 6)
+//   1 deposit A    step 4. DEPOSIT_TRACK (track-length deposits, track_deposit_pass.h):
+//   2 deposit B      A = (Φ along the step = ½ (Φ_old + Φ_new), flag: < 0 none, 0 deposit,
+//                    1 deposit and clip at the receiver plane), B = (Φ received, 1 when received);
+//                  otherwise at the new midpoint m, in the voxel containing it (inside the grid):
+//                    accumulate: A = (Φ·Δs_m/V_voxel, atlas x), B = (lum(Φ)·Δs_m·d, atlas y)
 //                    max:        A = (E = Φ/A, atlas x),         B = (d, atlas y)
 //                    atlas x = −1: no deposit. Δs_m = Δt/n(m_old) (Eq. 4.11).
-//   3 ledger A     (flux absorbed in step 2, fate code of lightsim/fate.glsl)
-//   4 ledger B     (flux reflected in step 3, 1 when the patch left a boundary layer)
+//   3 ledger A     (flux absorbed in step 2, code = fate + FATE_SPAWNS + FATE_ROLLED_BACK)
+//   4 ledger B     (flux reflected in step 3 and not followed, 1 when it reflected)
 // Slots at or beyond uCount get count 0 and FATE_NONE.
+// RECEIVER: a patch whose midpoint crosses the receiver plane in this step, or that left the box
+// heading for it, is received (receiver.h): its footprint (the corners' rays on the plane) must
+// exist. SHARP_INTERFACES: the update pass's events (sharp.glsl, patch.glsl), blocked and trapped
+// patches, and the reflected wavefront followed once every corner is through (CPU twin stepPatch).
 #include "common/volume.glsl"
 #include "lightsim/grid.glsl"
 #include "lightsim/patch.glsl"
+#include "lightsim/fresnel.glsl"
 #include "lightsim/fate.glsl"
 #include "lightsim/atlas.glsl"
+#ifdef SHARP_INTERFACES
+#include "lightsim/sharp.glsl"
+uniform int uBounces;          // reflections followed per wavefront (--bounces)
+const int kMaxTotalReflections = 16;  // cpu_simulator.cpp: trapped by total internal reflection
+#endif
+#ifdef RECEIVER
+uniform vec3 uReceiverPoint;   // the plane, in the grid's local coordinates
+uniform vec3 uReceiverNormal;  // unit, facing the light
+#endif
 
 uniform sampler2D uPatch[8];      // the list after the update
 uniform sampler2D uPrevious[4];   // P0..P3 before the update
@@ -28,14 +46,23 @@ layout(location = 2) out vec4 oDepositB;
 layout(location = 3) out vec4 oLedgerA;
 layout(location = 4) out vec4 oLedgerB;
 
+#ifdef RECEIVER
+// The patch's footprint on the plane exists: no corner's ray runs parallel to it (patchFootprint).
+bool footprintExists(Patch p) {
+  for (int c = 0; c < 4; ++c)
+    if (dot(p.w[c], uReceiverNormal) == 0.0) return false;
+  return true;
+}
+#endif
+
 void main() {
   ivec2 texel = ivec2(gl_FragCoord.xy);
+  oDepositA = vec4(0.0, 0.0, 0.0, -1.0);
+  oDepositB = vec4(0.0);
+  oLedgerB = vec4(0.0);
   if (mortonIndex(texel) >= uCount) {
     oCount = vec4(0.0);
-    oDepositA = vec4(0.0, 0.0, 0.0, -1.0);
-    oDepositB = vec4(0.0);
     oLedgerA = vec4(0.0, 0.0, 0.0, float(FATE_NONE));
-    oLedgerB = vec4(0.0);
     return;
   }
   Patch p;
@@ -44,35 +71,93 @@ void main() {
   FETCH_CORNERS(uPrevious, texel, o0, o1, o2, o3);
   vec3 mOld = 0.25 * (o0 + o1 + o2 + o3);
   vec3 fluxOld = texelFetch(uPreviousFlux, texel, 0).rgb;
-
-  // Step 5.
-  int fate = patchFate(p);
-  oCount = vec4(fateCount(fate), 0.0, 0.0, 0.0);
-
-  // The ledger: step 2's factor recomputed exactly as update.frag did (same inputs, same code),
-  // and step 3's reflection from it and T_fresnel.
-  vec3 a = absorptionFactor(mOld, uDt);
-  oLedgerA = vec4(fluxOld * (1.0 - a), float(fate));
-  oLedgerB = p.tFresnel < 1.0 ? vec4(fluxOld * a * (1.0 - p.tFresnel), 1.0) : vec4(0.0);
-
-  // Step 4: the voxel containing m, floor of the continuous voxel coordinate, inside [0, dims).
   vec3 m = patchMidpoint(p);
-  vec3 c = floor((m - uBoundsMin) * uInvExtent * vec3(ATLAS_DIMS));
-  if (!(all(greaterThanEqual(c, vec3(0.0))) && all(lessThan(c, vec3(ATLAS_DIMS))))) {
-    oDepositA = vec4(0.0, 0.0, 0.0, -1.0);
-    oDepositB = vec4(0.0);
+  vec3 d = patchDirection(p);
+
+#ifdef SHARP_INTERFACES
+  // Undone steps: the patch (as it was) splits, or dies torn at the depth limit; nothing else
+  // happened in them.
+  if ((p.event & (SHARP_EVENT_SPLIT_U | SHARP_EVENT_SPLIT_V)) != 0) {
+    int axes = p.event & 3;
+    int fate = axes == 3 ? FATE_SPLIT : axes == 1 ? FATE_SPLIT_U : FATE_SPLIT_V;
+    oCount = vec4(fateCount(fate), 0.0, 0.0, 0.0);
+    oLedgerA = vec4(0.0, 0.0, 0.0, float(fate + FATE_ROLLED_BACK));
     return;
   }
+  if ((p.event & SHARP_EVENT_TORN) != 0) {
+    oCount = vec4(0.0);
+    oLedgerA = vec4(0.0, 0.0, 0.0, float(FATE_DEPTH));
+    return;
+  }
+  vec3 a = sharpAbsorptionFactor(mOld, uDt);
+  vec3 reflected = fluxOld * a * (1.0 - p.tFresnel);
+  // The reflected wavefront leaves the interface once every corner is through (bounces).
+  bool spawns = false;
+  vec3 spawnFlux = vec3(0.0);
+  if (p.crossed == 15 && p.bounce < uBounces && p.reflectPending > 0.0 && p.reflectPending < 1.0) {
+    spawnFlux = p.flux * (p.reflectPending / (1.0 - p.reflectPending));
+    Patch r;
+    spawns = max(max(spawnFlux.r, spawnFlux.g), spawnFlux.b) >= uFluxKill * exp2(-2.0 * p.depth) &&
+             reflectedPatch(p, 4.0 * uDt + 2.0 * uVoxelEdge, r);
+  }
+  int blocked = p.event / SHARP_EVENT_BLOCKED;
+  bool splittable = oneMedium(p) && blocked == 0;
+#else
+  vec3 a = absorptionFactor(mOld, uDt);
+  vec3 reflected = p.tFresnel < 1.0 ? fluxOld * a * (1.0 - p.tFresnel) : vec3(0.0);
+  bool spawns = false;
+  vec3 spawnFlux = vec3(0.0);
+  int blocked = 0;
+  bool splittable = true;
+#endif
+
+  // The receiver: the midpoint crossed the plane in this step, or it left the box towards it.
+  bool reached = false;
+#ifdef RECEIVER
+  float aboveOld = dot(mOld - uReceiverPoint, uReceiverNormal);
+  float aboveNew = dot(m - uReceiverPoint, uReceiverNormal);
+  bool crossedPlane = aboveOld > 0.0 && aboveNew <= 0.0;
+  bool headingThere = !insideBox(m, uBoxMin, uBoxMax) && !rayHitsBox(m, d, uBoxMin, uBoxMax) && aboveNew > 0.0 &&
+                      dot(d, uReceiverNormal) < 0.0;
+  reached = (crossedPlane || headingThere) && footprintExists(p);
+#endif
+
+  // Step 5.
+  int fate;
+  if (reached) fate = FATE_RECEIVED;
+  else if (blocked >= 2) fate = FATE_BLOCKED;
+#ifdef SHARP_INTERFACES
+  else if (p.reflections > kMaxTotalReflections) fate = FATE_DEPTH;
+#endif
+  else fate = patchFate(p, splittable);
+  oCount = vec4(fateCount(fate) + (spawns ? 1.0 : 0.0), 0.0, 0.0, 0.0);
+
+  // The ledger: step 2's factor recomputed exactly as update.frag did (same inputs, same code),
+  // step 3's reflection from it and T_fresnel, less what a followed reflection carries on.
+  oLedgerA = vec4(fluxOld * (1.0 - a), float(fate + (spawns ? FATE_SPAWNS : 0)));
+  if (p.tFresnel < 1.0 || spawns) oLedgerB = vec4(reflected - (spawns ? spawnFlux : vec3(0.0)), p.tFresnel < 1.0 ? 1.0 : 0.0);
+
+#ifdef DEPOSIT_TRACK
+  oDepositA = vec4(0.5 * (fluxOld + p.flux), reached ? 1.0 : 0.0);
+  if (reached) oDepositB = vec4(p.flux, 1.0);
+#else
+  // Step 4: the voxel containing m, floor of the continuous voxel coordinate, inside [0, dims).
+  vec3 c = floor((m - uBoundsMin) * uInvExtent * vec3(ATLAS_DIMS));
+  if (!(all(greaterThanEqual(c, vec3(0.0))) && all(lessThan(c, vec3(ATLAS_DIMS))))) return;
   vec2 at = vec2(atlasTexel(ivec3(c)));
-  vec3 d = patchDirection(p);
 #ifdef DEPOSIT_MAX
   float area = length(patchAreaVector(p));
   vec3 e = area > 0.0 ? p.flux / area : vec3(0.0);  // Eq. 4.16: E = Φ / A
   oDepositA = vec4(e, at.x);
   oDepositB = vec4(d, at.y);
 #else
+#ifdef SHARP_INTERFACES
+  float dsm = uDt / mediumIor(mOld);  // Δs_m, Eq. 4.11, n of m_old's material
+#else
   float dsm = uDt / sampleIor(mOld);  // Δs_m, Eq. 4.11
+#endif
   oDepositA = vec4(p.flux * (dsm / uVoxelVolume), at.x);
   oDepositB = vec4(lum(p.flux) * dsm * d, at.y);
+#endif
 #endif
 }

@@ -7,11 +7,21 @@
 // x2 = (1,1), x3 = (0,1)) at the child's parameter cell (j mod nu, j div nu); w renormalised to n
 // at the new corner; Φ_child = Φ·A_child/Σ A (flux conserved); depth + 1 (2×2) or + ½ (1×2),
 // A0 = A_child; n_in, cos_in and T_fresnel inherited (wavefront.h splitPatch).
+// SHARP_INTERFACES: children take the parent's material (a patch splits only inside one) and w is
+// renormalised to that material's n; a crossing whose corners are all through is closed (crossed
+// and reflect_pending reset); a code with FATE_SPAWNS adds, as the source's last slot, the
+// reflected wavefront (sharp.glsl reflectedPatch) with the flux Φ·R/(1 − R) the crossing reflected,
+// one bounce more (cpu_simulator.cpp stepPatch, step 3).
 #include "common/volume.glsl"
 #include "lightsim/grid.glsl"
 #include "lightsim/patch.glsl"
 #include "lightsim/fate_codes.glsl"
 #include "lightsim/histo_pyramid.glsl"
+#ifdef SHARP_INTERFACES
+#include "lightsim/fresnel.glsl"
+#include "lightsim/sharp.glsl"
+uniform float uDt;  // Δt (the reach of reflectedPatch: 4 Δt + 2 h)
+#endif
 
 uniform sampler2D uPatch[8];   // the updated list (source)
 uniform sampler2D uPyramid;    // histogram pyramid over its counts
@@ -40,9 +50,28 @@ void main() {
   ivec2 source = hpFind(uPyramid, k, j);
   Patch p;
   FETCH_PATCH(uPatch, source, p);
-  int fate = int(texelFetch(uLedgerA, source, 0).w + 0.5);
-
-  if (fateSplits(fate)) {
+  int code = int(texelFetch(uLedgerA, source, 0).w + 0.5);
+  int fate = fateOf(code);
+  bool reflection = fateSpawns(code) && float(j) == fateCount(fate);  // the source's last slot
+#ifdef SHARP_INTERFACES
+  p.event = 0;
+  if (reflection) {
+    // The reflected wavefront (computed exactly as the analysis did when it counted the slot).
+    Patch r;
+    reflectedPatch(p, 4.0 * uDt + 2.0 * uVoxelEdge, r);
+    r.flux = p.flux * (p.reflectPending / (1.0 - p.reflectPending));
+    r.area0 = length(patchAreaVector(r));
+    r.bounce = p.bounce + 1;
+    r.reflectPending = 0.0;
+    r.crossed = 0;
+    r.tFresnel = 1.0;
+    p = r;
+  } else if (p.crossed == 15) {
+    p.crossed = 0;  // every corner is through: the crossing is closed
+    p.reflectPending = 0.0;
+  }
+#endif
+  if (fateSplits(fate) && !reflection) {
     // nu × nv children (2×2, 2×1 or 1×2); child j covers parameter cell (j mod nu, j div nu) of
     // the grid (u, v) = (a/nu, b/nv) (wavefront.h splitPatch).
     ivec2 cells = fateSplitCells(fate);
@@ -70,7 +99,13 @@ void main() {
       child.x[c] = bilinear(p.x[0], p.x[1], p.x[2], p.x[3], uv.x, uv.y);
       vec3 w = bilinear(p.w[0], p.w[1], p.w[2], p.w[3], uv.x, uv.y);
       float len = length(w);
-      child.w[c] = len > 0.0 ? w * (sampleIor(child.x[c]) / len) : w;  // |w| = n at the new corner
+#ifdef SHARP_INTERFACES
+      child.medium[c] = oneMedium(p) ? p.medium[0] : materialAt(child.x[c]);
+      float n = materialOptics(child.medium[c], child.x[c]).x;
+#else
+      float n = sampleIor(child.x[c]);
+#endif
+      child.w[c] = len > 0.0 ? w * (n / len) : w;  // |w| = n at the new corner
     }
     float children = float(nu * nv);
     child.flux = total > 0.0 ? p.flux * (areas[j] / total) : p.flux / children;

@@ -7,14 +7,18 @@ uniform float uSplitLength;  // split_voxels · h
 uniform float uMaxDepth;     // max_depth
 uniform bool uKillAtMaxDepth;  // DepthLimit::Kill (else a patch at max_depth is kept unsplit)
 uniform bool uAxisSplit;     // SplitRule::Axis: halve only the directions whose edges are too long
+uniform vec3 uBoxMin;        // the propagation box (wavefront.h propagationBox): the grid's,
+uniform vec3 uBoxMax;        //   grown by h for track deposits
 
-int patchFate(Patch p) {
+// The fate of an updated patch; `splittable` false keeps (or kills at the edge limit) a patch that
+// must not split (with sharp interfaces: corners in different materials, or stopped ones).
+int patchFate(Patch p, bool splittable) {
   vec3 m = patchMidpoint(p);
   vec3 d = patchDirection(p);
   // flux: max(Φ) < flux_threshold · Φ_ref / 4^depth
   if (max(max(p.flux.r, p.flux.g), p.flux.b) < uFluxKill * exp2(-2.0 * p.depth)) return FATE_FLUX;
   // exited: m outside the grid box and the straight ray (m, d) misses it
-  if (!insideGrid(m) && !rayHitsGrid(m, d)) return FATE_EXITED;
+  if (!insideBox(m, uBoxMin, uBoxMax) && !rayHitsBox(m, d, uBoxMin, uBoxMax)) return FATE_EXITED;
 #ifdef DEPOSIT_MAX
   // folded: N · d ≤ 0 (or NaN). Only in `max` mode, like the CPU twin: an accumulate deposit does
   // not divide by the area, so a caustic singularity does no harm there.
@@ -33,6 +37,6 @@ int patchFate(Patch p) {
   if (!(splitU || splitV)) return FATE_KEEP;
   // At max_depth: kept unsplit (DepthLimit::Keep) while the longest edge is at most
   // kMaxUnsplitEdge (4) split lengths (wavefront.h), else killed.
-  if (p.depth >= uMaxDepth) return uKillAtMaxDepth || max(uEdge, vEdge) > 4.0 * uSplitLength ? FATE_DEPTH : FATE_KEEP;
+  if (!splittable || p.depth >= uMaxDepth) return uKillAtMaxDepth || max(uEdge, vEdge) > 4.0 * uSplitLength ? FATE_DEPTH : FATE_KEEP;
   return splitU && splitV ? FATE_SPLIT : splitU ? FATE_SPLIT_U : FATE_SPLIT_V;
 }

@@ -6,6 +6,7 @@ uniform vec3 uBoundsMax;
 uniform vec3 uInvExtent;
 uniform float uVoxelEdge;    // h, the smallest voxel edge
 uniform float uVoxelVolume;  // V_voxel
+uniform ivec3 uDims;         // voxels per axis
 
 vec3 gridUvw(vec3 x) { return (x - uBoundsMin) * uInvExtent; }
 
@@ -13,7 +14,6 @@ vec3 gridUvw(vec3 x) { return (x - uBoundsMin) * uInvExtent; }
 // GL_LINEAR + GL_CLAMP_TO_EDGE filtering done by hand with texelFetch and float weights, in the
 // order of the CPU twin's sampler (wavefront.cpp interpolate): hardware filtering quantises the
 // weights (to 1/256 on NVIDIA GPUs), this agrees with the CPU to float rounding. 8 fetches a lookup.
-uniform ivec3 uDims;
 vec4 exactTrilinear(sampler3D s, vec3 uvw) {
   vec3 top = vec3(uDims - 1);
   vec3 c = clamp(uvw * vec3(uDims) - 0.5, vec3(0.0), top);
@@ -48,25 +48,26 @@ vec3 sampleIorGrad(vec3 x) { return volumeIorGrad(gridUvw(x)); }
 vec3 sampleSigmaA(vec3 x) { return volumeSigmaA(gridUvw(x)); }
 #endif
 
-// Inside the closed box [bounds_min, bounds_max] (wavefront.h insideBox).
-bool insideGrid(vec3 x) { return all(greaterThanEqual(x, uBoundsMin)) && all(lessThanEqual(x, uBoundsMax)); }
-
-// Whether the ray x + t·d, t ≥ 0, meets the closed grid box (slab test, as wavefront.h rayHitsBox:
-// a zero component misses unless x lies within that slab).
-bool rayHitsGrid(vec3 x, vec3 d) {
+// Inside the closed box [lo, hi] (wavefront.h insideBox).
+bool insideBox(vec3 x, vec3 lo, vec3 hi) { return all(greaterThanEqual(x, lo)) && all(lessThanEqual(x, hi)); }
+// Whether the ray x + t·d, t ≥ 0, meets the closed box [lo, hi] (slab test, as wavefront.h
+// rayHitsBox: a zero component misses unless x lies within that slab).
+bool rayHitsBox(vec3 x, vec3 d, vec3 lo, vec3 hi) {
   float tNear = 0.0, tFar = 3.4e38;
   for (int a = 0; a < 3; ++a) {
     if (d[a] == 0.0) {
-      if (x[a] < uBoundsMin[a] || x[a] > uBoundsMax[a]) return false;
+      if (x[a] < lo[a] || x[a] > hi[a]) return false;
       continue;
     }
-    float t1 = (uBoundsMin[a] - x[a]) / d[a];
-    float t2 = (uBoundsMax[a] - x[a]) / d[a];
+    float t1 = (lo[a] - x[a]) / d[a];
+    float t2 = (hi[a] - x[a]) / d[a];
     tNear = max(tNear, min(t1, t2));
     tFar = min(tFar, max(t1, t2));
   }
   return tNear <= tFar;
 }
+bool insideGrid(vec3 x) { return insideBox(x, uBoundsMin, uBoundsMax); }
+bool rayHitsGrid(vec3 x, vec3 d) { return rayHitsBox(x, d, uBoundsMin, uBoundsMax); }
 
 // Absorption factor of ALGORITHM.md step 2 for a patch whose midpoint was m_old:
 // exp(−σa(m)·Δs_m) with Δs_m = Δt / n(m) (Eq. 4.11).

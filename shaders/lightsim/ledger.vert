@@ -11,6 +11,9 @@
 // k mod uBins, so no texel sums more than count/uBins values in float (bins and rows are summed in
 // double on readback) and the points spread over many texels instead of contending for one.
 // Patches with nothing to add are culled. LEDGER_UNFINISHED: the final list, entry 7 only.
+// LEDGER_EXTRA: the entries of receivers and sharp interfaces, into a second set of four targets:
+//   0 received (Φ, count)   1 blocked (Φ, count)   2 reflections followed (0, count)
+//   3 steps undone before a crossing (0, count)
 #include "lightsim/patch.glsl"
 #include "lightsim/fate_codes.glsl"
 
@@ -27,12 +30,21 @@ void main() {
   for (int i = 0; i < 8; ++i) vEntry[i] = vec4(0.0);
   ivec2 texel = mortonTexel(gl_VertexID);
   bool emit = true;
-#ifdef LEDGER_UNFINISHED
+#if defined(LEDGER_UNFINISHED)
   vEntry[7] = vec4(texelFetch(uFlux, texel, 0).rgb, 1.0);
+#elif defined(LEDGER_EXTRA)
+  int code = int(texelFetch(uLedgerA, texel, 0).w + 0.5);
+  int fate = fateOf(code);
+  vec4 dead = vec4(texelFetch(uFlux, texel, 0).rgb, 1.0);
+  if (fate == FATE_RECEIVED) vEntry[0] = dead;
+  if (fate == FATE_BLOCKED) vEntry[1] = dead;
+  if (fateSpawns(code)) vEntry[2] = vec4(0.0, 0.0, 0.0, 1.0);
+  if (fateRolledBack(code)) vEntry[3] = vec4(0.0, 0.0, 0.0, 1.0);
+  emit = fate == FATE_RECEIVED || fate == FATE_BLOCKED || code >= FATE_SPAWNS;
 #else
   vec4 a = texelFetch(uLedgerA, texel, 0);
   vec4 b = texelFetch(uLedgerB, texel, 0);
-  int fate = int(a.w + 0.5);
+  int fate = fateOf(int(a.w + 0.5));
   vEntry[0] = vec4(a.rgb, 0.0);
   vEntry[1] = b;
   vec4 dead = fate >= FATE_EXITED ? vec4(texelFetch(uFlux, texel, 0).rgb, 1.0) : vec4(0.0);
@@ -41,7 +53,7 @@ void main() {
   if (fate == FATE_FOLDED) vEntry[4] = dead;
   if (fate == FATE_DEPTH) vEntry[5] = dead;
   if (fateSplits(fate)) vEntry[6] = vec4(0.0, 0.0, 0.0, 1.0);
-  emit = fate >= FATE_SPLIT || b.w > 0.0 || any(greaterThan(a.rgb, vec3(0.0)));
+  emit = fate >= FATE_SPLIT || b.w > 0.0 || any(notEqual(b.rgb, vec3(0.0))) || any(greaterThan(a.rgb, vec3(0.0)));
 #endif
   vec2 ndc = (vec2(float(gl_VertexID % uBins), float(uRow)) + 0.5) / uLedgerSize * 2.0 - 1.0;
   gl_Position = emit ? vec4(ndc, 0.0, 1.0) : vec4(2.0, 2.0, 2.0, 1.0);

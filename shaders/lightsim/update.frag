@@ -8,10 +8,23 @@
 //   2. Absorption: Φ ← Φ·exp(−σa(m_old)·Δs_m), Δs_m = Δt / n(m_old) (Eq. 4.11).
 //   3. Fresnel boundary tracking (docs/physics.md): enter a layer when |∇n(m_new)|·h > g_on, leave it
 //      when < g_off and keep the transmitted fraction 1 − R (boundaryReflectance, fresnel.glsl).
+// SHARP_INTERFACES (ALGORITHM.md "Sharp interfaces"; the CPU twin's stepPatch): each corner
+// crosses the interfaces on its chord with Snell's law and the exact Fresnel R (sharp.glsl); the
+// patch keeps Π (1 − R_c)^¼ of its flux. A step that would tear the patch — stretched past
+// kTearFactor split lengths, or a first touch whose other corners will not meet the same surface
+// (willTear) — is undone and the event tells the analysis to split the patch as it was
+// (SHARP_EVENT_SPLIT_U/V), or, at the depth limit, that it dies (SHARP_EVENT_TORN).
 #include "common/volume.glsl"
 #include "lightsim/grid.glsl"
 #include "lightsim/patch.glsl"
 #include "lightsim/fresnel.glsl"
+#ifdef SHARP_INTERFACES
+#include "lightsim/sharp.glsl"
+uniform float uSplitLength;  // split_voxels · h · (1 + margin)
+uniform float uMaxDepth;     // max_depth
+uniform bool uAxisSplit;     // SplitRule::Axis
+const float kTearFactor = 2.0;  // cpu_simulator.cpp
+#endif
 
 uniform sampler2D uPatch[8];
 uniform int uCount;            // live patches
@@ -59,6 +72,96 @@ void stepCorner(inout vec3 x, inout vec3 w) {
   w = normalize(wn) * sampleIor(xn);  // |w| = n(x_new)
 }
 
+void writePatch(Patch p) {
+  vec4 t[8];
+  packPatch(p, t);
+  oP0 = t[0]; oP1 = t[1]; oP2 = t[2]; oP3 = t[3];
+  oW01 = t[4]; oW23 = t[5]; oFlux = t[6]; oMeta = t[7];
+}
+
+#ifdef SHARP_INTERFACES
+// The split axes of a patch whose edges exceed `threshold` (wavefront.h splitAxes): bit 0 u, bit 1 v.
+int splitAxesOf(Patch p, float threshold) {
+  float uEdge = max(distance(p.x[0], p.x[1]), distance(p.x[3], p.x[2]));
+  float vEdge = max(distance(p.x[1], p.x[2]), distance(p.x[0], p.x[3]));
+  if (uAxisSplit) return (uEdge > threshold ? 1 : 0) | (vEdge > threshold ? 2 : 0);
+  return max(uEdge, vEdge) > threshold ? 3 : 0;
+}
+float longestEdge(Patch p) {
+  float e = 0.0;
+  for (int c = 0; c < 4; ++c) e = max(e, distance(p.x[(c + 1) % 4], p.x[c]));
+  return e;
+}
+// willTear (cpu_simulator.cpp): some corners met an interface, the others (not in `metMask`) must
+// each find the same surface ahead on their straight rays within `reach`, or the patch tears.
+bool willTear(Patch p, int metMask, float reach) {
+  int slot = -1;
+  for (int c = 0; c < 4; ++c) {
+    if (((metMask >> c) & 1) != 0) continue;
+    float f;
+    int k, entered;
+    vec3 d = normalize(p.w[c]);
+    if (!findInterface(p.x[c], p.x[c] + reach * d, p.medium[c], f, k, entered)) return true;
+    if (slot >= 0 && k != slot) return true;
+    slot = k;
+  }
+  return false;
+}
+
+void main() {
+  ivec2 texel = ivec2(gl_FragCoord.xy);
+  if (mortonIndex(texel) >= uCount) discard;
+  Patch p;
+  FETCH_PATCH(uPatch, texel, p);
+  p.event = 0;
+  Patch before = p;
+  vec3 mOld = patchMidpoint(p);
+
+  // Step 1 with sharp interfaces.
+  float transmittance = 1.0;
+  int metMask = 0, transmittedMask = 0, blocked = 0, reflections = 0;
+  for (int c = 0; c < 4; ++c) {
+    CornerCrossings cc = advanceCornerSharp(p.x[c], p.w[c], p.medium[c], uDt);
+    if (cc.transmitted > 0 || cc.reflected > 0 || cc.blocked) metMask |= 1 << c;
+    reflections += cc.reflected;
+    blocked += cc.blocked ? 1 : 0;
+    if (cc.transmitted > 0) transmittedMask |= 1 << c;
+    transmittance *= pow(cc.transmittance, 0.25);
+  }
+  p.reflections += reflections;
+  if (metMask != 0 && oneMedium(before)) {
+    bool stretched = splitAxesOf(p, kTearFactor * uSplitLength) != 0;
+    bool firstTouch = metMask != 15;
+    bool tears = stretched || (firstTouch && willTear(p, metMask, 4.0 * max(longestEdge(p), uVoxelEdge)));
+    if (tears && p.depth >= uMaxDepth) {
+      before.event = SHARP_EVENT_TORN;  // dies before it deposits anything
+      writePatch(before);
+      return;
+    }
+    if (tears) {
+      int axes = splitAxesOf(p, uSplitLength);
+      if (axes == 0) axes = splitAxesOf(before, 0.0);  // a tear ahead: halve it
+      before.event = axes;
+      writePatch(before);
+      return;
+    }
+  }
+
+  // Step 2: absorption at the old midpoint, n of its material there.
+  p.flux *= sharpAbsorptionFactor(mOld, uDt);
+
+  // Step 3: Fresnel at the interfaces the corners crossed; the reflected fraction is remembered
+  // until every corner is through (the analysis may then follow the reflected wavefront).
+  p.tFresnel = transmittance;
+  if (transmittance < 1.0) {
+    p.flux *= transmittance;
+    p.reflectPending = 1.0 - (1.0 - p.reflectPending) * transmittance;
+  }
+  p.crossed |= transmittedMask;
+  p.event = SHARP_EVENT_BLOCKED * blocked;
+  writePatch(p);
+}
+#else
 void main() {
   ivec2 texel = ivec2(gl_FragCoord.xy);
   if (mortonIndex(texel) >= uCount) discard;
@@ -92,9 +195,6 @@ void main() {
     p.tFresnel = 1.0 - r;
     p.nIn = 0.0;
   }
-
-  vec4 t[8];
-  packPatch(p, t);
-  oP0 = t[0]; oP1 = t[1]; oP2 = t[2]; oP3 = t[3];
-  oW01 = t[4]; oW23 = t[5]; oFlux = t[6]; oMeta = t[7];
+  writePatch(p);
 }
+#endif
