@@ -26,7 +26,9 @@
 #include "lightsim/list_set.h"
 #include "lightsim/patch_textures.h"
 #include "lightsim/receiver.h"
+#include "lightsim/receiver_pass.h"
 #include "lightsim/step_uniforms.h"
+#include "lightsim/track_deposit_pass.h"
 #include "lightsim/update_pass.h"
 #include "lightsim/wavefront.h"
 
@@ -75,6 +77,8 @@ struct GpuSimulator::Impl {
   std::map<std::tuple<DepositMode, bool, bool>, std::unique_ptr<gpu::AnalysisPass>> analyses;
   std::map<int, std::unique_ptr<gpu::CompactPass>> compacts;  // by pyramid levels
   std::unique_ptr<gpu::LedgerPass> ledger;
+  std::unique_ptr<gpu::ReceiverPass> receiverPass;
+  std::unique_ptr<gpu::TrackDepositPass> trackPass;
 
   Impl(const Volume& v, const GpuSimulatorOptions& o)
       : config(o),
@@ -170,6 +174,14 @@ struct GpuSimulator::Impl {
                           r.find("swrast") != std::string::npos;
     return software ? gl::PhaseTimer::Mode::Off : gl::PhaseTimer::Mode::Queries;
   }
+  gpu::TrackDepositPass& trackPassFor() {
+    if (!trackPass) trackPass = std::make_unique<gpu::TrackDepositPass>(library, atlasLayout);
+    return *trackPass;
+  }
+  gpu::ReceiverPass& receiverPassFor() {
+    if (!receiverPass) receiverPass = std::make_unique<gpu::ReceiverPass>(library);
+    return *receiverPass;
+  }
   gpu::LedgerPass& ledgerFor() {
     if (!ledger) ledger = std::make_unique<gpu::LedgerPass>(library, config.ledger_interval);
     return *ledger;
@@ -198,10 +210,6 @@ GpuSimulator::~GpuSimulator() {
 }
 
 BakeResult GpuSimulator::run(const LightSpec& light, const SimulationOptions& options) {
-  if (options.deposit == DepositMode::Accumulate && options.deposit_kernel == DepositKernel::Track)
-    throw InputError("lightsim options", "deposit_kernel",
-                     "the GPU path deposits at patch midpoints only (DepositKernel::Point) so far");
-  if (options.receiver) throw InputError("lightsim options", "receiver", "the GPU path makes no receiver maps yet");
   if (ownedContext_ && gl::GlContext::current() != ownedContext_.get()) ownedContext_->makeCurrent();
   return impl_->run(light, options);
 }
@@ -284,6 +292,11 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
 
   AtlasTargets atlas(atlasLayout, options.deposit);
   info.atlas_bytes = atlas.bytes();
+  gpu::ReceiverTarget receiverTarget;
+  if (options.receiver) {
+    receiverTarget = gpu::ReceiverTarget(receiver.texels);
+    info.atlas_bytes += receiverTarget.bytes();
+  }
   gpu::LedgerPass& ledger = ledgerFor();
   ledger.reset();
 
@@ -300,6 +313,20 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
 
   const gpu::UpdatePass& updatePass = update(options.integrator);
   const gpu::DepositPass& depositPass = deposit(options.deposit);
+  // Track deposits: the bound on a patch-step's extent (in voxels, any axis) that sizes the pass's
+  // points. Patches are split at split_voxels and kept up to kMaxUnsplitEdge split lengths, a
+  // quadrilateral spans at most twice its longest edge, and a step adds step_voxels; half as much
+  // again covers patches that stretch within one step before the analysis splits them.
+  gpu::TrackDepositUniforms trackUniforms;
+  if (track) {
+    trackUniforms.grid = gridUniforms;
+    trackUniforms.receiverEnabled = options.receiver.has_value();
+    trackUniforms.receiverPoint = step.receiverPoint;
+    trackUniforms.receiverNormal = step.receiverNormal;
+    const double extent = 2.0 * kMaxUnsplitEdge * options.split_voxels + options.step_voxels;
+    trackUniforms.maxExtentVoxels =
+        std::min(trackPassFor().maxExtentVoxels(), static_cast<int>(std::ceil(1.5 * extent)) + 2);
+  }
   const gpu::AnalysisPass& analysisPass = analyse(options.deposit, track, options.receiver.has_value());
   const bool extraLedger = sharp || options.receiver.has_value();
   stats.phase_seconds["init"] = phaseWatch.seconds();
@@ -332,7 +359,14 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     timer.start("analysis");
     analysisPass.run(L.b, L.a, count, L.targets, volume, gridUniforms, step);
     timer.start("deposit");
-    depositPass.run(L.targets.depositA, L.targets.depositB, count, atlas, energyRef);
+    if (track)
+      trackPassFor().run(L.a, L.b, L.targets.depositA, count, atlas, trackUniforms);
+    else
+      depositPass.run(L.targets.depositA, L.targets.depositB, count, atlas, energyRef);
+    if (options.receiver) {
+      timer.start("receiver");
+      receiverPassFor().run(L.b, L.targets.depositB, count, receiverTarget, receiver, origin);
+    }
     timer.start("ledger");
     ledger.addStep(L.targets, L.b, count, extraLedger);
     timer.start("pyramid");
@@ -402,6 +436,10 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
 
   phaseWatch.restart();
   atlas.toFields(bake.irradiance, bake.light_dir);
+  if (options.receiver) {
+    receiverTarget.fill(receiver);
+    bake.receivers.push_back(std::move(receiver));
+  }
   stats.phase_seconds["output"] = phaseWatch.seconds();
 
   info.patch_bytes_peak = gpu::ListSet::bytesFor(info.peak_patch_side);

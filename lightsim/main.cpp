@@ -67,7 +67,7 @@ int run(int argc, char** argv) {
   app.add_option("--deposit-kernel", kernel,
                  "track (default: flux times path length over the patch's footprint, with each voxel's trilinear "
                  "hat: flat in free air) or point (the first release: all of it at the voxel of the patch's "
-                 "midpoint; the only kernel of the GPU path so far)")
+                 "midpoint; no receiver map with it on the GPU)")
       ->check(CLI::IsMember({"track", "point"}));
   app.add_option("--backend", backend,
                  "auto (default: gl on a hardware GPU for what the GPU path does, cpu otherwise), gl (the GPU "

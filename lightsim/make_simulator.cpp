@@ -12,10 +12,9 @@
 namespace eik {
 
 std::string gpuPathLacks(const Volume& volume, const SimulationOptions& simulation) {
-  if (volume.has("interfaces")) return "sharp interfaces (the volume has an interfaces field)";
-  if (simulation.deposit == DepositMode::Accumulate && simulation.deposit_kernel == DepositKernel::Track)
-    return "track deposits (--deposit-kernel track)";
-  if (simulation.receiver) return "receiver maps";
+  (void)volume;
+  const bool track = simulation.deposit == DepositMode::Accumulate && simulation.deposit_kernel == DepositKernel::Track;
+  if (simulation.receiver && !track) return "receiver maps with point deposits (use --deposit-kernel track)";
   return "";
 }
 

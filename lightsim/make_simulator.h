@@ -31,8 +31,8 @@ struct SimulatorBackendOptions {
   std::function<void(const std::string&)> report;
 };
 
-// What the GPU path cannot do yet (ALGORITHM.md "Back ends"): sharp interfaces, track deposits,
-// receiver maps. Returns "" when it can bake `volume` with `simulation`, else the reason.
+// What the GPU path cannot do (ALGORITHM.md "Back ends"): a receiver map with point deposits.
+// Returns "" when it can bake `volume` with `simulation`, else the reason.
 std::string gpuPathLacks(const Volume& volume, const SimulationOptions& simulation);
 
 // The simulator for `volume` (see GpuSimulator's and CpuSimulator's constructors for what they

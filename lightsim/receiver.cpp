@@ -78,9 +78,11 @@ int clipAgainst(const glm::dvec2* in, int count, glm::dvec2* out, int axis, doub
   return n;
 }
 
+// Shoelace as a fan around the first vertex: relative coordinates keep the precision of a polygon
+// far smaller than its distance from the origin (a footprint focused onto the plane).
 double polygonArea(const glm::dvec2* p, int count) {
   double twice = 0.0;
-  for (int i = 0; i < count; ++i) twice += cross2(p[i], p[(i + 1) % count]);
+  for (int i = 1; i + 1 < count; ++i) twice += cross2(p[i] - p[0], p[i + 1] - p[0]);
   return 0.5 * std::abs(twice);
 }
 

@@ -68,30 +68,35 @@ TEST(LightsimCli, AutoBackendPicksTheTwinOnASoftwareRasterizer) {
   EXPECT_EQ(stats["backend"], software ? "cpu" : "gl") << r.output;
 }
 
-// What the GPU path cannot do yet (track deposits, sharp interfaces, receiver maps): auto takes the
-// twin and says why; an explicit --backend gl is refused (exit 2) before any work.
-TEST(LightsimCli, TheGpuPathRefusesWhatItCannotDoYet) {
+// The GPU path bakes sharp interfaces with track deposits and a receiver map (the CPU twin's
+// defaults); what it cannot do — a receiver map with point deposits — auto leaves to the twin and
+// says why, and an explicit --backend gl refuses (exit 2) before any work.
+TEST(LightsimCli, TheGpuPathBakesSharpInterfacesAndRefusesWhatItCannotDo) {
   TempDir dir;
-  makeSphere(dir);
+  makeSphere(dir, true);
   ProgramResult r = runProgram(LIGHTSIM_EXE,
-                               {"ball.vol.json", "-o", "t.vol.json", "--light", "directional:0,-1,0", "--max-depth", "2",
-                                "--stats", "t.json"},
+                               {"sharp.vol.json", "-o", "g.vol.json", "--light", "directional:0,-1,0", "--backend", "gl",
+                                "--max-depth", "2", "--receiver", "0,-0.7,0:0,1,0", "--stats", "g.json"},
                                dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("the GPU path does not do track deposits"), std::string::npos) << r.output;
-  EXPECT_EQ(nlohmann::json::parse(readFile(dir / "t.json"))["backend"], "cpu");
-  r = runProgram(LIGHTSIM_EXE, {"ball.vol.json", "-o", "g.vol.json", "--light", "directional:0,-1,0", "--backend", "gl"},
-                 dir.path());
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("--backend: gl: the GPU path does not do track deposits"), std::string::npos) << r.output;
-  EXPECT_FALSE(std::filesystem::exists(dir / "g.vol.json"));
-  makeSphere(dir, true);
+  const nlohmann::json stats = nlohmann::json::parse(readFile(dir / "g.json"));
+  EXPECT_EQ(stats["backend"], "gl");
+  EXPECT_NE(r.output.find("lightsim: receiver '"), std::string::npos) << r.output;
   r = runProgram(LIGHTSIM_EXE,
-                 {"sharp.vol.json", "-o", "s.vol.json", "--light", "directional:0,-1,0", "--backend", "gl",
-                  "--deposit-kernel", "point"},
+                 {"sharp.vol.json", "-o", "p.vol.json", "--light", "directional:0,-1,0", "--max-depth", "2",
+                  "--deposit-kernel", "point", "--receiver", "0,-0.7,0:0,1,0", "--stats", "p.json"},
+                 dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("the GPU path does not do receiver maps with point deposits"), std::string::npos) << r.output;
+  EXPECT_EQ(nlohmann::json::parse(readFile(dir / "p.json"))["backend"], "cpu");
+  r = runProgram(LIGHTSIM_EXE,
+                 {"sharp.vol.json", "-o", "x.vol.json", "--light", "directional:0,-1,0", "--backend", "gl",
+                  "--deposit-kernel", "point", "--receiver", "0,-0.7,0:0,1,0"},
                  dir.path());
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("the GPU path does not do sharp interfaces"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--backend: gl: the GPU path does not do receiver maps with point deposits"), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.vol.json"));
 }
 
 // --smooth-irradiance is a normalised filter: the light's total stays (the sphere sits well inside
