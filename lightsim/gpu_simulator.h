@@ -9,11 +9,17 @@
 //                                                                                  deposit A/B,         work of
 //                                                                                  ledger A/B           2–4
 //   deposit   deposit_pass.h   GL_POINTS, one per patch   deposit A/B              atlas (blend/depth)  4
+//     or track  track_deposit_  GL_POINTS, one per patch   lists A and B (corners   atlas (blend)        4
+//               pass.h           and atlas z-slice          before, after), dep. A
+//   receiver  receiver_pass.h  GL_TRIANGLES, two quads    list B, deposit B        receiver map (blend) 4
+//                              per received patch         (flux received)
 //   ledger    ledger_pass.h    GL_POINTS, one per patch   ledger A/B, list B       ledger row (blend)   ledger
 //   pyramid   histo_pyramid.h  HistoPyramid::build        counts                   pyramid; the total   6
 //                                                                                  is read back
 //   compact   compact_pass.h   full-screen, new live box  list B, pyramid, fate    list A (8 MRT)       6
 //
+// With sharp interfaces (an `interfaces` field) the update, analysis and compaction passes are
+// compiled with SHARP_INTERFACES (shaders/lightsim/sharp.glsl; ALGORITHM.md "Sharp interfaces").
 // (Lists A and B and the step targets: list_set.h, step_targets.h; the uniforms: grid_uniforms.h,
 // step_uniforms.h; the atlas: atlas.h.) All per-patch arithmetic happens in the fragment passes;
 // the point passes only fetch a few texels and scatter them (on llvmpipe vertex shading runs on one
@@ -87,9 +93,9 @@ struct GpuRunInfo {
 
 class GpuSimulator : public Simulator {
  public:
-  // Uploads n, ∇n and σa of `volume` (the only fields read) and compiles nothing yet. Uses the
-  // current GL context, or creates a headless one (options.backend) and owns it when none is
-  // current. InputError ("volume too large for the GPU: ...") when the grid's flat-3D atlas does
+  // Uploads n, ∇n, σa and the interface distances of `volume` (the only fields read) and compiles
+  // nothing yet. Uses the current GL context, or creates a headless one (options.backend) and owns
+  // it when none is current. InputError ("volume too large for the GPU: ...") when the grid's flat-3D atlas does
   // not fit GL_MAX_TEXTURE_SIZE, the grid GL_MAX_3D_TEXTURE_SIZE, or the textures the budget.
   explicit GpuSimulator(const Volume& volume, GpuSimulatorOptions options = {});
   // The same in `context` when it is not null, which the simulator then owns (and makes current):

@@ -13,6 +13,9 @@
 #            - "bake": the receiver map itself (ring_compare map), and
 #            - "viewer": viewer --render floor.exr 256×256 from the camera below (ring_compare image).
 #   POV-Ray  the same scene and camera, photons (ring_compare image --pov), at several photon counts.
+# Each receiver map is also read against the exact tracer binned into that map's own texels
+# (ring_compare trace --through-map): where E jumps at the shadow's edge, a ring measured by texel
+# centres differs from the exact ring at any bake, and that row says by how much.
 # The viewer and POV-Ray images are measured on the floor pixels whose straight ray from the eye
 # misses the sphere grown to 1.05 (the camera sits low to the side, so it sees the floor under the
 # sphere below it; ring_compare reports the fraction of each ring it sees).
@@ -133,7 +136,11 @@ eikonal() {  # $1 resolution, $2 sharp|smooth
     --label "Eikonal $res³ $mode: bake (receiver map)" --time "voxelize=$vox" --time "bake=$bake" >>"$run_log" 2>&1
   "$ring_compare" image "$out/$name.floor.exr" --camera "$camera" -o "$out/$name.image.json" \
     --label "Eikonal $res³ $mode: viewer image" --time "render=$render" >>"$run_log" 2>&1
-  results+=("$out/$name.map.json" "$out/$name.image.json")
+  # The exact answer seen through this map's texels (binned by texel centre like the map): at the
+  # shadow's edge a texel-centre ring mixes in its neighbour's light, bake or no bake.
+  "$ring_compare" trace --through-map "$out/$name.baked.vol.json" --rays "$rays" -o "$out/$name.exact_map.json" \
+    --label "exact through the $res³ $mode map's texels" >>"$run_log" 2>&1
+  results+=("$out/$name.exact_map.json" "$out/$name.map.json" "$out/$name.image.json")
 }
 for res in $resolutions; do eikonal "$res" sharp; done
 eikonal "$smooth_res" smooth

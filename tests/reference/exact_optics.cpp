@@ -74,9 +74,10 @@ void tallyOnReceiver(const Receiver& receiver, glm::dvec3 p, double flux, Tally&
   const auto ring = static_cast<std::size_t>(r / receiver.ring_width);
   if (ring < tally.rings.size()) tally.rings[ring] += flux;
   if (receiver.map_texels > 0) {
-    const double half = 0.5 * receiver.map_texels;
-    const double fu = glm::dot(offset, receiver.map_u) / receiver.map_pitch + half;
-    const double fv = glm::dot(offset, receiver.map_v) / receiver.map_pitch + half;
+    const glm::dvec2 corner = receiver.map_origin_given ? receiver.map_origin
+                                                        : glm::dvec2(-0.5 * receiver.map_texels * receiver.map_pitch);
+    const double fu = (glm::dot(offset, receiver.map_u) - corner.x) / receiver.map_pitch;
+    const double fv = (glm::dot(offset, receiver.map_v) - corner.y) / receiver.map_pitch;
     if (fu >= 0.0 && fv >= 0.0 && fu < receiver.map_texels && fv < receiver.map_texels) {
       const auto iu = static_cast<std::size_t>(fu), iv = static_cast<std::size_t>(fv);
       tally.map[iv * static_cast<std::size_t>(receiver.map_texels) + iu] += flux;

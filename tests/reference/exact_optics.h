@@ -69,6 +69,10 @@ struct Receiver {
   int map_texels = 0;
   double map_pitch = 0.0;
   glm::dvec3 map_u{1.0, 0.0, 0.0}, map_v{0.0, 0.0, 1.0};
+  // The map's corner in (u, v) relative to `center` (a ReceiverMap's origin); by default the map is
+  // centred on `center`.
+  bool map_origin_given = false;
+  glm::dvec2 map_origin{0.0};
 };
 
 struct TraceOptions {

@@ -13,6 +13,7 @@
 //   - the shadow radius: where the radial profile first climbs past E = ½ going out from r = 0.9.
 //
 //   ring_compare trace -o exact.json [--rays N]        the exact tracer (tests/reference/exact_optics.h)
+//   ring_compare trace --through-map BAKED.vol.json -o e.json   the same, binned into that map's texels
 //   ring_compare map BAKED.vol.json -o eik.json         the receiver map lightsim baked (texel centres)
 //   ring_compare image FLOOR.exr --camera E:T:FOV -o img.json [--albedo 0.8] [--pov]
 //                                                        a rendered image of the floor
@@ -176,7 +177,26 @@ json readJson(const std::string& path) {
 // the sphere's axis (so the floor out to r = 3.5 gets all its light), traced with exact Fresnel and
 // every bounce (tests/reference/exact_optics.h); rings of width 0.0025 on the floor.
 
-json modeTrace(std::uint64_t rays, std::uint64_t seed, int threads) {
+// Builds the texel-centre profile of a map (as `map` below measures a baked one).
+Profile mapProfile(const eik::ReceiverMap& map, const std::vector<double>& irradiance, double* covered_to) {
+  Profile p(0.0025);
+  const double a = map.pitch * map.pitch;
+  *covered_to = 1e9;  // the largest radius the map covers all round
+  for (int j = 0; j < map.texels.y; ++j)
+    for (int i = 0; i < map.texels.x; ++i) {
+      const glm::dvec3 c = map.texelCenter(i, j);
+      p.add(std::hypot(c.x, c.z), irradiance[static_cast<std::size_t>(j) * map.texels.x + i], a);
+      if (i == 0 || j == 0 || i + 1 == map.texels.x || j + 1 == map.texels.y)
+        *covered_to = std::min(*covered_to, std::hypot(c.x, c.z));
+    }
+  return p;
+}
+
+// `through_map` (a baked volume): the exact answer as that volume's receiver map sees it — the
+// tracer's flux binned into the same texels, each texel's mean irradiance binned by its centre. At
+// the shadow's edge (r = 1, where E jumps twentyfold) a texel-centre ring mixes in the neighbouring
+// ring's light whatever the bake: this row shows how much, so the bake's rows can be read against it.
+json modeTrace(std::uint64_t rays, std::uint64_t seed, int threads, const std::string& through_map) {
   eik::reference::DirectionalBeam beam;
   beam.direction = {0.0, -1.0, 0.0};
   beam.beam_center = kSphereCenter;
@@ -185,6 +205,19 @@ json modeTrace(std::uint64_t rays, std::uint64_t seed, int threads) {
   eik::reference::Receiver receiver;  // the plane y = 0 facing up, centred on (0, 0, 0)
   receiver.ring_width = 0.0025;
   receiver.max_radius = kMaxRadius;
+  eik::ReceiverMap map;
+  if (!through_map.empty()) {
+    const eik::Volume volume = eik::readVolume(through_map);
+    if (volume.receivers.empty()) throw std::runtime_error(through_map + ": no receiver map");
+    map = volume.receivers.front();
+    if (map.texels.x != map.texels.y) throw std::runtime_error(through_map + ": the tracer's map must be square");
+    receiver.map_texels = map.texels.x;
+    receiver.map_pitch = map.pitch;
+    receiver.map_u = map.u;
+    receiver.map_v = map.v;
+    receiver.map_origin_given = true;
+    receiver.map_origin = map.origin;
+  }
   eik::reference::TraceOptions options;
   options.rays = rays;
   options.seed = seed;
@@ -197,6 +230,18 @@ json modeTrace(std::uint64_t rays, std::uint64_t seed, int threads) {
     const double area = annulusArea(i * tally.ring_width, (i + 1) * tally.ring_width);
     p.ew[i] = tally.ring_flux[i];  // Σ E·w is the flux through the ring
     p.w[i] = area;
+  }
+  if (!through_map.empty()) {
+    std::vector<double> e(tally.map_flux.size());
+    for (std::size_t t = 0; t < e.size(); ++t) e[t] = tally.map_flux[t] / (map.pitch * map.pitch);
+    double covered_to = 0.0;
+    json j = summarize(mapProfile(map, e, &covered_to), 1.0);
+    j["kind"] = "map";
+    j["texels"] = {map.texels.x, map.texels.y};
+    j["pitch"] = map.pitch;
+    j["map_covers_radius"] = covered_to;
+    j["rays"] = rays;
+    return j;
   }
   json j = summarize(p);
   j["kind"] = "exact";
@@ -217,18 +262,10 @@ json modeMap(const std::string& volume_path, double direct) {
   const eik::Volume volume = eik::readVolume(volume_path);
   if (volume.receivers.empty()) throw std::runtime_error(volume_path + ": no receiver map");
   const eik::ReceiverMap& map = volume.receivers.front();
-  Profile p(0.0025);
-  const double a = map.pitch * map.pitch;
-  double covered_to = 1e9;  // the largest radius the map covers all round
-  for (int j = 0; j < map.texels.y; ++j)
-    for (int i = 0; i < map.texels.x; ++i) {
-      const glm::dvec3 c = map.texelCenter(i, j);
-      const double e = map.irradiance[3 * (static_cast<std::size_t>(j) * map.texels.x + i)];
-      p.add(std::hypot(c.x, c.z), e, a);
-      if (i == 0 || j == 0 || i + 1 == map.texels.x || j + 1 == map.texels.y)
-        covered_to = std::min(covered_to, std::hypot(c.x, c.z));
-    }
-  json j = summarize(p, direct);
+  std::vector<double> e(map.texelCount());
+  for (std::size_t t = 0; t < e.size(); ++t) e[t] = map.irradiance[3 * t];
+  double covered_to = 0.0;
+  json j = summarize(mapProfile(map, e, &covered_to), direct);
   j["kind"] = "map";
   j["texels"] = {map.texels.x, map.texels.y};
   j["pitch"] = map.pitch;
@@ -424,6 +461,9 @@ int main(int argc, char** argv) {
   trace->add_option("--rays", rays, "rays over the beam's disc of radius 3.6 (default 2e7)");
   trace->add_option("--seed", seed, "random seed (default 1)");
   trace->add_option("--threads", threads, "threads (default 0: all)");
+  std::string through_map;
+  trace->add_option("--through-map", through_map,
+                    "BAKED.vol.json: bin the rays into its receiver map's texels and measure them as `map` does");
   CLI::App* map = app.add_subcommand("map", "rings of the receiver map of a baked volume");
   common(map);
   map->add_option("volume", input, "BAKED.vol.json")->required();
@@ -449,7 +489,7 @@ int main(int argc, char** argv) {
     json j;
     const auto start = std::chrono::steady_clock::now();
     if (trace->parsed()) {
-      j = modeTrace(static_cast<std::uint64_t>(rays), seed, threads);
+      j = modeTrace(static_cast<std::uint64_t>(rays), seed, threads, through_map);
       // The tracer's own wall time, unless the caller gives times.
       if (times.empty())
         times.push_back("trace=" + std::to_string(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()));
