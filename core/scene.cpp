@@ -8,6 +8,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/json_input.h"
 
 namespace eik {
 namespace {
@@ -204,14 +205,11 @@ Scene sceneFromJson(const json& j, const std::string& source) {
 }
 
 Scene readScene(const std::filesystem::path& file) {
-  std::ifstream in(file);
+  std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string(), "", "cannot open the scene file");
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw InputError(file.string(), "", std::string("not valid JSON: ") + e.what());
-  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  const json j = parseJsonInput(text.str(), file.string());
   Scene scene = sceneFromJson(j, file.string());
   scene.base_dir = std::filesystem::absolute(file).parent_path();
   return scene;

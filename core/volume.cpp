@@ -13,6 +13,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/json_input.h"
 #include "core/limits.h"
 #include "core/nrrd.h"
 
@@ -176,16 +177,7 @@ class ManifestReader {
     if (!in) throw InputError(name_, "", std::string("cannot open: ") + std::strerror(errno));
     std::ostringstream text;
     text << in.rdbuf();
-    nlohmann::json root;
-    try {
-      root = nlohmann::json::parse(text.str());
-    } catch (const nlohmann::json::parse_error& e) {
-      // "[json.exception.parse_error.101] parse error at line 3, column 5: ..." without the tag.
-      std::string what = e.what();
-      std::size_t tag_end = what.find("] ");
-      if (what.rfind("[json.exception", 0) == 0 && tag_end != std::string::npos) what = what.substr(tag_end + 2);
-      throw InputError(name_, "JSON", what);
-    }
+    nlohmann::json root = parseJsonInput(text.str(), name_);
     if (!root.is_object()) throw InputError(name_, "JSON", "expected an object at the top level");
     return root;
   }

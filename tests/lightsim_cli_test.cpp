@@ -168,6 +168,16 @@ TEST(LightsimCli, BadInputExitsTwo) {
   Volume v = readVolume(dir / "ball.vol.json");
   v.fields.erase("ior_grad");
   writeVolume(v, dir / "nograd.vol.json");
+  // Hostile manifests (issue "Reliability"): a key nested 10⁶ deep, a number beyond double.
+  {
+    const std::string text = readFile(dir / "ball.vol.json");
+    std::string deep = "{\"extra\": ";
+    for (int i = 0; i < 1000000; ++i) deep += "[";
+    std::ofstream(dir / "deep.vol.json") << deep;
+    std::string huge = text;
+    huge.insert(huge.find('{') + 1, "\"spacing_hint\": 1e999,");
+    std::ofstream(dir / "huge.vol.json") << huge;
+  }
   struct Case {
     std::vector<std::string> args;
     const char* expected;
@@ -182,6 +192,9 @@ TEST(LightsimCli, BadInputExitsTwo) {
       {{"missing.vol.json", "-o", "x.vol.json", "--light", "directional:0,-1,0"}, "missing.vol.json"},
       {{"ball.vol.json", "-o", "x.nrrd", "--light", "directional:0,-1,0"}, ".vol.json"},
       {{"ball.vol.json", "-o", "x.vol.json", "--light", "directional:0,-1,0", "--backend", "cuda"}, "--backend"},
+      {{"deep.vol.json", "-o", "x.vol.json", "--light", "directional:0,-1,0"}, "deep.vol.json: JSON: nested deeper"},
+      {{"huge.vol.json", "-o", "x.vol.json", "--light", "directional:0,-1,0"},
+       "huge.vol.json: spacing_hint: number out of range"},
   };
   for (const Case& c : cases) {
     ProgramResult r = runProgram(LIGHTSIM_EXE, c.args, dir.path());

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/json_input.h"
 #include "voxelize/gltf_diagnostics.h"
 
 namespace eik {
@@ -84,15 +85,7 @@ GlbParts splitGlb(const std::string& file, const std::vector<unsigned char>& byt
 
 void precheckGltfJson(const std::string& file, const std::string& text, const std::filesystem::path& base_dir,
                       const GlbParts* glb) {
-  nlohmann::json root;
-  try {
-    root = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    std::string what = e.what();
-    if (auto pos = what.find("] "); what.rfind("[json.exception", 0) == 0 && pos != std::string::npos)
-      what = what.substr(pos + 2);
-    throw InputError(file, "json", what);
-  }
+  const nlohmann::json root = parseJsonInput(text, file, "json");
   if (!root.is_object()) throw InputError(file, "json", "the top level is not an object");
   auto buffers = root.find("buffers");
   if (buffers == root.end() || !buffers->is_array()) return;

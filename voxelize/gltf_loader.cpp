@@ -123,24 +123,48 @@ class GltfReader {
     return m;
   }
 
-  void visit(int index, const glm::dmat4& parent) {
-    const auto n = static_cast<std::size_t>(index);
-    const std::string field = indexed("nodes", n);
-    if (on_path_[n]) fail(field + ".children", "cycle in the node hierarchy");
-    on_path_[n] = true;
-    const tinygltf::Node& node = model_.nodes[n];
-    const glm::dmat4 world = parent * localMatrix(node, field);
-    if (node.mesh >= 0) instanceMesh(node, field, world);
-    if (node.camera >= 0)
-      if (std::optional<SceneCamera> camera = gltfCamera(model_, node, field, world, diag_)) scene_.cameras.push_back(*camera);
-    if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end())
-      if (std::optional<SceneLight> light = gltfLight(model_, node, it->second, field, world, diag_))
-        scene_.lights.push_back(*light);
-    for (int c : node.children) {
-      checkNodeIndex(c, field + ".children");
-      visit(c, world);
+  // The node hierarchy, depth first in the file's order, with an explicit stack (a chain of 10⁵
+  // nodes must not overflow the call stack): each node's world matrix, mesh, camera and light.
+  // A hierarchy deeper than kMaxNodeDepth levels or with a cycle is refused.
+  static constexpr std::size_t kMaxNodeDepth = 1024;
+  void visit(int root, const glm::dmat4& parent) {
+    struct Frame {
+      std::size_t node;
+      glm::dmat4 world;
+      std::size_t next_child = 0;
+    };
+    std::vector<Frame> stack;
+    auto enter = [&](int index, const glm::dmat4& above) {
+      const auto n = static_cast<std::size_t>(index);
+      const std::string field = indexed("nodes", n);
+      if (on_path_[n]) fail(field + ".children", "cycle in the node hierarchy");
+      if (stack.size() >= kMaxNodeDepth)
+        fail(field, "the node hierarchy is deeper than " + str(kMaxNodeDepth) + " levels (the limit)");
+      on_path_[n] = true;
+      const tinygltf::Node& node = model_.nodes[n];
+      const glm::dmat4 world = above * localMatrix(node, field);
+      if (node.mesh >= 0) instanceMesh(node, field, world);
+      if (node.camera >= 0)
+        if (std::optional<SceneCamera> camera = gltfCamera(model_, node, field, world, diag_)) scene_.cameras.push_back(*camera);
+      if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end())
+        if (std::optional<SceneLight> light = gltfLight(model_, node, it->second, field, world, diag_))
+          scene_.lights.push_back(*light);
+      stack.push_back({n, world});
+    };
+    enter(root, parent);
+    while (!stack.empty()) {
+      Frame& top = stack.back();
+      const tinygltf::Node& node = model_.nodes[top.node];
+      if (top.next_child == node.children.size()) {
+        on_path_[top.node] = false;
+        stack.pop_back();
+        continue;
+      }
+      const int child = node.children[top.next_child++];
+      checkNodeIndex(child, indexed("nodes", top.node) + ".children");
+      const glm::dmat4 world = top.world;  // `top` may move when the stack grows
+      enter(child, world);
     }
-    on_path_[n] = false;
   }
 
   // --- meshes -------------------------------------------------------------------------------------

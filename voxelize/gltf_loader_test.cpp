@@ -382,6 +382,27 @@ TEST_F(GltfLoader, TruncatedGlbIsAnInputError) {
   }
 }
 
+// A hierarchy is walked with an explicit stack: a chain of 10⁵ nodes (which overflowed the call
+// stack of the recursive walk) is refused past the depth limit with the node named, and a chain
+// within the limit loads with its transforms composed.
+TEST_F(GltfLoader, DeepNodeChainIsRefusedWithoutACrash) {
+  for (const int length : {100000, 1000}) {
+    GltfBuilder b;
+    const int mesh = b.addMesh(makeBox({0, 0, 0}, {1, 1, 1}), -1, "Box");
+    int child = b.addNode({{"mesh", mesh}});
+    for (int i = 1; i < length; ++i) child = b.addNode({{"translation", {0.001, 0.0, 0.0}}, {"children", {child}}});
+    b.setScene({child});
+    const std::filesystem::path file = write("chain.gltf", b.embedded());
+    if (length > 1024) {
+      expectInputError(file, {"nodes[", "deeper than 1024 levels"});
+    } else {
+      const MeshScene scene = loadMeshFile(file);
+      ASSERT_EQ(scene.meshes.size(), 1u);
+      EXPECT_NEAR(scene.meshes[0].bounds().min.x, 0.001 * (length - 1), 1e-6);
+    }
+  }
+}
+
 TEST_F(GltfLoader, TruncatedJsonIsAnInputError) {
   GltfBuilder b;
   b.setScene({b.addNode({{"mesh", b.addMesh(makeBox({0, 0, 0}, {1, 1, 1}))}})});
