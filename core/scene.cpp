@@ -1,6 +1,7 @@
 #include "core/scene.h"
 
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <initializer_list>
 #include <set>
@@ -73,6 +74,12 @@ class ObjectReader {
     const json& v = at(key);
     if (!v.is_array() || v.size() != 2 || !v[0].is_number_integer() || !v[1].is_number_integer())
       fail(child(key), "expected an array of 2 integers");
+    // Read as 64-bit and range-checked: get<int>() would wrap 4294967312 to 16.
+    for (int i = 0; i < 2; ++i) {
+      const bool fits = v[i].is_number_unsigned() ? v[i].get<std::uint64_t>() <= 0x7fffffffu
+                                                   : v[i].get<std::int64_t>() >= -0x7fffffffLL - 1;
+      if (!fits) fail(child(key), "has a value out of the integer range");
+    }
     return {v[0].get<int>(), v[1].get<int>()};
   }
 
@@ -195,7 +202,8 @@ Scene sceneFromJson(const json& j, const std::string& source) {
     if (scene.render.size.x < 1 || scene.render.size.y < 1 || scene.render.size.x > 16384 || scene.render.size.y > 16384)
       r.fail("render.size", "must be between 1 and 16384 pixels per axis");
     scene.render.step_voxels = r.number("step_voxels", scene.render.step_voxels);
-    if (!(scene.render.step_voxels > 0)) r.fail("render.step_voxels", "must be positive");
+    if (!(scene.render.step_voxels >= 0.01 && scene.render.step_voxels <= 4.0))
+      r.fail("render.step_voxels", "must be between 0.01 and 4 (as viewer --step)");
     scene.render.exposure = r.number("exposure", 0.0);
     scene.render.tonemap = r.string("tonemap", scene.render.tonemap);
     if (scene.render.tonemap != "aces" && scene.render.tonemap != "reinhard" && scene.render.tonemap != "linear")

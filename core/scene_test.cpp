@@ -62,6 +62,10 @@ TEST(Scene, RejectsWrongTypes) {
   EXPECT_NE(errorOf(R"({"lights": [{"type": "spot"}]})").find("lights[0].type"), std::string::npos);
   EXPECT_NE(errorOf(R"({"render": {"size": [0, 10]}})").find("render.size"), std::string::npos);
   EXPECT_NE(errorOf(R"({"render": {"tonemap": "filmic"}})").find("render.tonemap"), std::string::npos);
+  // Integers beyond int are refused, not wrapped (4294967312 became 16); the step as viewer --step.
+  EXPECT_NE(errorOf(R"({"render": {"size": [4294967312, 16]}})").find("render.size: has a value out of the integer range"),
+            std::string::npos);
+  EXPECT_NE(errorOf(R"({"render": {"step_voxels": 1e-300}})").find("render.step_voxels"), std::string::npos);
   EXPECT_NE(errorOf(R"({"objects": [{"translate": [0,0,0]}]})").find("objects[0].volume"), std::string::npos);
   EXPECT_NE(errorOf(R"({"objects": [{"volume": "a", "scale": -1}]})").find("objects[0].scale"), std::string::npos);
   EXPECT_NE(errorOf(R"({"lights": [{"type": "directional", "direction": [0,0,0]}]})").find("zero vector"),

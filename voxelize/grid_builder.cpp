@@ -54,11 +54,14 @@ GridSpec makeGrid(const Bounds& objects, int res, double pad_voxels, const std::
   if (!(longest > 0.0) || !std::isfinite(longest))
     throw InputError("voxelize", "bounds", "the inputs have no extent (a single point); give --bounds");
   const double h = longest / res;
+  if (pad_voxels > kMaxGridDim)
+    throw InputError("--pad", "", str(pad_voxels) + " voxels of air exceed the largest grid dimension " +
+                                      std::to_string(kMaxGridDim));
   const int pad = static_cast<int>(std::ceil(pad_voxels - 1e-9));
   for (int a = 0; a < 3; ++a) {
     // The longest axis gets exactly `res` voxels; the tolerance keeps 1.0000000001 from becoming 2.
     const double span = std::max(1.0, std::ceil(ext[a] / h - 1e-6));
-    grid.dims[a] = checkedDim(span + 2.0 * pad, axes[a], "--res");
+    grid.dims[a] = checkedDim(span + 2.0 * pad, axes[a], span <= kMaxGridDim ? "--pad" : "--res");
   }
   const glm::dvec3 half = 0.5 * h * glm::dvec3(grid.dims);
   grid.bounds_min = objects.center() - half;

@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "core/grid.h"
+#include "core/limits.h"
 
 namespace eik {
 
@@ -42,8 +43,9 @@ struct Bounds {
 // air and the boundary layer lies wholly inside the grid (central differences need one more voxel
 // on each side). With 2 voxels the border would still hold about 2 % of the index step.
 constexpr double kDefaultPadVoxels = 3.0;
-// Largest grid dimension makeGrid accepts (a 4096³ float field is already 256 GiB).
-constexpr int kMaxGridDim = 4096;
+// Largest grid dimension makeGrid accepts: what the volume writer and every reader accept
+// (core/limits.h), so a grid too large fails before any work.
+constexpr int kMaxGridDim = kMaxVolumeAxis;
 
 // Grid for objects spanning `objects`:
 //  - without explicit bounds: cubic voxels of size h = (longest extent of `objects`) / res, the

@@ -84,6 +84,12 @@ TEST(GridBuilder, Errors) {
   EXPECT_EQ(message([&] { makeGrid(unit, 64, 2, box({0, 0, 0}, {1, -1, 1})); }).rfind("--bounds: y:", 0), 0u);
   // A thin, long object at a high resolution would need more than kMaxGridDim voxels across.
   EXPECT_NE(message([&] { makeGrid(box(glm::dvec3(0), glm::dvec3(1)), 4096, 100); }), "");
+  // The limit is the writer's (1024, core/limits.h), checked before any work; the padding that
+  // pushes a grid over it is named, and a huge --pad neither overflows nor blames --res.
+  EXPECT_EQ(message([&] { makeGrid(unit, 1025, 0); }).rfind("--res:", 0), 0u);
+  EXPECT_EQ(message([&] { makeGrid(unit, 1020, 3); }).rfind("--pad:", 0), 0u);
+  EXPECT_EQ(message([&] { makeGrid(unit, 64, 1e9); }).rfind("--pad:", 0), 0u);
+  EXPECT_NO_THROW(makeGrid(unit, 1018, 3));
 }
 
 TEST(GridBuilder, ParseBounds) {
