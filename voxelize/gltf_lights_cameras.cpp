@@ -1,5 +1,8 @@
 #include "voxelize/gltf_lights_cameras.h"
 
+#include <cmath>
+#include <cstdio>
+
 #include <tiny_gltf.h>
 
 #include <cstddef>
@@ -7,14 +10,26 @@
 
 namespace eik {
 
+namespace {
+// A JSON number as written: integers without a fraction, others with %g.
+std::string numberText(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.10g", v);
+  return text;
+}
+}  // namespace
+
 std::optional<SceneLight> gltfLight(const tinygltf::Model& model, const tinygltf::Node& node, const tinygltf::Value& ext,
                                     const std::string& field, const glm::dmat4& world, const GltfDiagnostics& diag) {
   const std::string lfield = field + ".extensions.KHR_lights_punctual.light";
   if (!ext.IsObject() || !ext.Has("light") || !ext.Get("light").IsNumber())
     diag.fail(lfield, "missing or not a number");
-  const int index = ext.Get("light").GetNumberAsInt();
-  if (index < 0 || static_cast<std::size_t>(index) >= model.lights.size())
-    diag.fail(lfield, "light " + str(index) + " out of range (the file has " + str(model.lights.size()) + " lights)");
+  // Range-checked as a double first: GetNumberAsInt converts a real such as 1e20 to int, which is
+  // undefined behaviour.
+  const double number = ext.Get("light").GetNumberAsDouble();
+  if (!(number >= 0.0 && number < static_cast<double>(model.lights.size())) || number != std::floor(number))
+    diag.fail(lfield, "light " + numberText(number) + " is not an index of the file's " + str(model.lights.size()) + " lights");
+  const int index = static_cast<int>(number);
   const tinygltf::Light& l = model.lights[static_cast<std::size_t>(index)];
   SceneLight light;
   if (l.type == "directional") light.type = SceneLight::Type::Directional;

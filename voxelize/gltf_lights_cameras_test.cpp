@@ -50,7 +50,13 @@ TEST(GltfLightsCameras, LightsTakeTheNodesPlaceAndDirection) {
   EXPECT_FALSE(gltfLight(model, node, lightRef(1), "nodes[4]", world, diag));
   EXPECT_EQ(warnings, std::vector<std::string>{"s.gltf: KHR_lights_punctual.lights[1]: type 'area' skipped"});
   EXPECT_EQ(inputErrorOf([&] { gltfLight(model, node, lightRef(2), "nodes[4]", world, diag); }),
-            "s.gltf: nodes[4].extensions.KHR_lights_punctual.light: light 2 out of range (the file has 2 lights)");
+            "s.gltf: nodes[4].extensions.KHR_lights_punctual.light: light 2 is not an index of the file's 2 lights");
+  // A real beyond int (converting it was undefined behaviour) and a fraction are refused alike.
+  for (const double bad : {1e20, -1.0, 0.5}) {
+    const tinygltf::Value ref(tinygltf::Value::Object{{"light", tinygltf::Value(bad)}});
+    EXPECT_CONTAINS(inputErrorOf([&] { gltfLight(model, node, ref, "nodes[4]", world, diag); }),
+                    "is not an index of the file's 2 lights");
+  }
   EXPECT_EQ(inputErrorOf([&] { gltfLight(model, node, tinygltf::Value(), "nodes[4]", world, diag); }),
             "s.gltf: nodes[4].extensions.KHR_lights_punctual.light: missing or not a number");
 }
