@@ -31,8 +31,8 @@ int fateCode(const PatchStepResult& r) {
     case PatchFate::KilledFlux: return 6;
     case PatchFate::Folded: return 7;
     case PatchFate::KilledDepth: return 8;
-    case PatchFate::Received:  // the GPU path has no receiver and no opaque stop yet
-    case PatchFate::Blocked: return 0;
+    case PatchFate::Received: return 9;
+    case PatchFate::Blocked: return 10;
   }
   return 0;
 }
