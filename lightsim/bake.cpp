@@ -66,6 +66,7 @@ nlohmann::json SimulationStats::toJson() const {
                 {"depth", kills.depth},       {"received", kills.received}, {"blocked", kills.blocked}};
   j["reflections"] = reflections;
   j["rollbacks"] = rollbacks;
+  j["flights"] = flights;
   // The energy ledger: flux_in = out + absorbed + reflected + killed + unfinished + received +
   // blocked (W, RGB).
   j["flux"] = {{"in", vec3Json(flux_in)},

@@ -182,6 +182,77 @@ bool willTear(const Patch& patch, const SharpUpdate& u, const VolumeSampler& sam
   return false;
 }
 
+// Free flight (ALGORITHM.md "Free flight"): the time of one straight step for the whole patch,
+// or 0 when it takes an ordinary step of Δt. Every corner moves on its straight ray
+// x_c + t·w_c/n_c², so the swept patch lies in the box of its corners at 0 and t (a bilinear patch
+// of linearly moving corners stays in their convex hull); the step is taken only where that box is
+// quiet. Its length: doubled from 2Δt while the box stays quiet, then refined by bisection, and
+// bounded so that no edge grows past the split length (or past its length now, if longer) and by
+// ctx.flight_cap.
+bool options_keep(const StepContext& ctx) { return ctx.options->at_max_depth == DepthLimit::Keep; }
+
+double freeFlightTime(const Patch& patch, const PatchSamples& samples, const StepContext& ctx, double threshold) {
+  if (ctx.sampler->sharp()) {
+    if (!oneMedium(patch) || patch.crossed != 0 || patch.reflect_pending != 0.0) return 0.0;
+  } else if (patch.n_in != 0.0) {
+    return 0.0;  // inside a boundary layer: its Fresnel exit is decided step by step
+  }
+  std::array<glm::dvec3, 4> v;
+  for (int c = 0; c < 4; ++c) {
+    const glm::dvec4& s = samples.corner[static_cast<std::size_t>(c)];
+    if (s.y != 0.0 || s.z != 0.0 || s.w != 0.0 || !(s.x > 0.0)) return 0.0;
+    v[static_cast<std::size_t>(c)] = patch.w[c] / (s.x * s.x);  // dx/dt, Eq. 6.1
+  }
+  // The longest an edge may grow to: the split length, or its length now if longer; at the depth
+  // limit, a kept patch as far as it would go on unsplit (stepPatch's analysis).
+  const bool kept = options_keep(ctx) && patch.depth >= ctx.options->max_depth;
+  double t_max = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < 4; ++c) {
+    // A path of length ℓ takes time ℓ·n (|dx/dt| = 1/n).
+    t_max = std::min(t_max, ctx.flight_cap * samples.corner[static_cast<std::size_t>(c)].x);
+    const int d = (c + 1) % 4;
+    // The edge e(t) = e₀ + t·Δv stays within L while |Δv|²t² + 2(e₀·Δv)t + |e₀|² − L² ≤ 0: up to the
+    // larger root (an edge that shrinks first, through a focus, may fly past it).
+    const glm::dvec3 e0 = patch.x[d] - patch.x[c];
+    const glm::dvec3 dv = v[static_cast<std::size_t>(d)] - v[static_cast<std::size_t>(c)];
+    const double a = glm::dot(dv, dv);
+    if (!(a > 0.0)) continue;
+    const double edge2 = glm::dot(e0, e0);
+    const double limit = kept ? kMaxUnsplitEdge * threshold : std::max(threshold, std::sqrt(edge2));
+    const double b = glm::dot(e0, dv);
+    const double disc = std::max(0.0, b * b - a * (edge2 - limit * limit));
+    t_max = std::min(t_max, (-b + std::sqrt(disc)) / a);
+  }
+  const double dt = ctx.dt;
+  if (!(t_max >= 2.0 * dt)) return 0.0;
+  auto quiet = [&](double t) {
+    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+    for (int c = 0; c < 4; ++c) {
+      const glm::dvec3 end = patch.x[c] + t * v[static_cast<std::size_t>(c)];
+      lo = glm::min(lo, glm::min(patch.x[c], end));
+      hi = glm::max(hi, glm::max(patch.x[c], end));
+    }
+    return ctx.quiet->quiet(lo, hi);
+  };
+  double good = 0.0, bad = 0.0;
+  for (double t = 2.0 * dt;; t *= 2.0) {
+    const double tt = std::min(t, t_max);
+    if (!quiet(tt)) {
+      bad = tt;
+      break;
+    }
+    good = tt;
+    if (tt >= t_max) break;
+  }
+  if (good == 0.0) return 0.0;
+  if (bad > 0.0)
+    for (int i = 0; i < 3; ++i) {
+      const double mid = 0.5 * (good + bad);
+      (quiet(mid) ? good : bad) = mid;
+    }
+  return good;
+}
+
 }  // namespace
 
 PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext& ctx) {
@@ -198,12 +269,22 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
   const glm::dvec3 m_old = patch.midpoint();
   const glm::dvec3 d_old = patch.direction();
   const double n_m_old = samples.n_mid;
-  const double ds = ctx.dt / n_m_old;  // Δs_m = Δt/n(m) (Eq. 4.11)
+  // Free flight: one straight step of this time across quiet space (0: a step of Δt).
+  const double flight = ctx.quiet && track ? freeFlightTime(patch, samples, ctx, threshold) : 0.0;
+  const double ds = (flight > 0.0 ? flight : ctx.dt) / n_m_old;  // Δs_m = Δt/n(m) (Eq. 4.11)
 
   // 1. Update (§6.2.2, Eq. 6.1/6.2 or RK2/RK4), then |w| = n(x_new); with sharp interfaces, Snell
   //    and Fresnel where a corner crosses one.
   SharpUpdate crossing;
-  if (sharp) {
+  if (flight > 0.0) {
+    // Straight rays (∇n = 0): Eq. 6.1 is exact for any step, Eq. 6.2 leaves w, n and the samples as
+    // they are, and no interface lies in the swept box.
+    result.flight = true;
+    for (int c = 0; c < 4; ++c) {
+      const double n = samples.corner[static_cast<std::size_t>(c)].x;
+      patch.x[c] += flight * patch.w[c] / (n * n);
+    }
+  } else if (sharp) {
     const PatchSamples samples_before = samples;
     crossing = updateCornersSharp(patch, samples, ctx);
     // A tear: undo the step and split the patch as it was, so that its parts cross on their own.
@@ -414,8 +495,10 @@ void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<Pat
   const std::size_t count = results.size();
   const glm::dvec3 h = grid.voxelSize();
   const double inv_volume = 1.0 / grid.voxelVolume();
-  // Slabs of z-slices, and the patches whose hats reach each one (in patch order).
-  const int slab_depth = std::max(1, grid.dims.z / (4 * static_cast<int>(workerThreads())));
+  // Slabs of z-slices, and the patches whose hats reach each one (in patch order). The slabs do
+  // not depend on the thread count: a sub-path is cut to each slab's reach (below), and where it
+  // is cut changes the last bits of its sums.
+  constexpr int slab_depth = 8;
   const int slabs = (grid.dims.z + slab_depth - 1) / slab_depth;
   by_slab.resize(static_cast<std::size_t>(slabs));
   for (auto& list : by_slab) list.clear();
@@ -456,9 +539,30 @@ void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<Pat
           const double length = glm::length(b - a);
           if (!(length > 0.0)) continue;
           const glm::dvec3 dir = (b - a) / length;
-          const glm::dvec3 e = flux * (length * inv_volume);
-          const glm::dvec3 dsum = (lum * length) * dir;
-          forEachTrackWeight(grid.toVoxel(a), grid.toVoxel(b), grid.dims, [&](long long v, double w) {
+          glm::dvec3 e = flux * (length * inv_volume);
+          glm::dvec3 dsum = (lum * length) * dir;
+          // The part of the sub-path within reach of this slab's hats (voxel z-coordinates
+          // (k0 − ½, k1 + ½) for slices k0..k1), the weights scaled by its share of the length:
+          // a long flight across many slabs is integrated once, not once a slab.
+          glm::dvec3 va = grid.toVoxel(a), vb = grid.toVoxel(b);
+          const double reach_lo = static_cast<double>(slab64 * slab_depth) - 0.5;
+          const double reach_hi = static_cast<double>(std::min<std::int64_t>(grid.dims.z, (slab64 + 1) * slab_depth)) + 0.5;
+          if (std::min(va.z, vb.z) < reach_lo || std::max(va.z, vb.z) > reach_hi) {
+            const double dz = vb.z - va.z;
+            double f0 = 0.0, f1 = 1.0;
+            if (dz != 0.0) {
+              const double g0 = (reach_lo - va.z) / dz, g1 = (reach_hi - va.z) / dz;
+              f0 = std::max(0.0, std::min(g0, g1));
+              f1 = std::min(1.0, std::max(g0, g1));
+            }
+            if (!(f1 > f0)) continue;
+            const glm::dvec3 span = vb - va;
+            vb = va + f1 * span;
+            va = va + f0 * span;
+            e *= f1 - f0;
+            dsum *= f1 - f0;
+          }
+          forEachTrackWeight(va, vb, grid.dims, [&](long long v, double w) {
             const std::size_t at = static_cast<std::size_t>(v);
             if (at - lo >= hi - lo) return;  // another slab's voxel (unsigned: also below lo)
             irradiance[at] += e * w;
@@ -485,6 +589,12 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   validateLight(light);
   validateOptions(options);
   StepContext ctx = makeStepContext(sampler_, options, 0.0);
+  if (options.free_flight && options.deposit == DepositMode::Accumulate &&
+      options.deposit_kernel == DepositKernel::Track) {
+    if (quiet_.empty()) quiet_ = sampler_.quietMap();
+    ctx.quiet = &quiet_;
+    ctx.flight_cap = glm::length(ctx.box_hi - ctx.box_lo);
+  }
   // The receiver's map (its geometry first: the initial patches cover it).
   ReceiverMap receiver;
   std::vector<glm::dvec3> receiver_flux;
@@ -517,6 +627,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   std::vector<PatchStepResult> results;
   std::vector<std::vector<std::uint32_t>> slab_lists;
   std::vector<std::uint64_t> offsets;
+  std::vector<std::uint32_t> received;  // this step's received patches
   std::vector<Patch> next;
   std::vector<PatchSamples> next_samples;
   double t_update = 0.0, t_deposit = 0.0, t_compact = 0.0;
@@ -551,6 +662,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
       stats.flux_absorbed += r.absorbed;
       stats.flux_reflected += r.reflected;
       if (r.rolled_back) ++stats.rollbacks;
+      if (r.flight) ++stats.flights;
       if (r.voxel >= 0) {
         const std::size_t v = static_cast<std::size_t>(r.voxel);
         if (accumulate) {
@@ -589,7 +701,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
         case PatchFate::Received:
           ++stats.kills.received;
           stats.flux_received += r.received;
-          depositFootprint(receiver, r.footprint, r.received, receiver_flux);
+          received.push_back(static_cast<std::uint32_t>(i));
           break;
         case PatchFate::Blocked:
           ++stats.kills.blocked;
@@ -604,6 +716,18 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
       }
     }
     offsets[count] = total;
+    // The receiver's footprints, by bands of texel rows in parallel (each band adds the patches in
+    // order, so the sums do not depend on the thread count).
+    if (!received.empty()) {
+      constexpr int kBandRows = 16;
+      const int bands = (receiver.texels.y + kBandRows - 1) / kBandRows;
+      parallelFor(0, bands, [&](std::int64_t band) {
+        const int row0 = static_cast<int>(band) * kBandRows;
+        for (const std::uint32_t i : received)
+          depositFootprint(receiver, results[i].footprint, results[i].received, receiver_flux, row0, row0 + kBandRows);
+      });
+      received.clear();
+    }
     t_deposit += t.seconds();
 
     // Step 6: compaction and expansion by the prefix sum, in index order (the histogram pyramid's

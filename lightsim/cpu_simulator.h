@@ -45,6 +45,7 @@ class CpuSimulator : public Simulator {
 
  private:
   VolumeSampler sampler_;
+  QuietMap quiet_;  // built by the first run with free flight
 };
 
 // One step of one patch in place: ALGORITHM.md steps 1–5 (update, absorption, Fresnel, deposit
@@ -74,6 +75,7 @@ struct PatchStepResult {
   // Sharp interfaces: the step was undone so that the patch splits before it crosses
   // (ALGORITHM.md "Sharp interfaces"), and the reflected wavefront to follow (bounces).
   bool rolled_back = false;
+  bool flight = false;             // a free flight (longer than Δt, straight)
   bool spawn_reflection = false;
   Patch reflection;
 };
@@ -86,6 +88,10 @@ struct StepContext {
   double voxel_volume = 0.0;
   glm::dvec3 box_lo{0.0}, box_hi{0.0};  // propagationBox
   const ReceiverMap* receiver = nullptr; // the receiver's geometry (no data), or none
+  // Free flight (SimulationOptions::free_flight): the quiet bricks, or none (steps of Δt only), and
+  // the longest flight (world units: the propagation box's diagonal).
+  const QuietMap* quiet = nullptr;
+  double flight_cap = 0.0;
 };
 
 // The constants of a run: Δt, the voxel volume, the propagation box (no receiver).

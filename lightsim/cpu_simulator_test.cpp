@@ -560,14 +560,19 @@ TEST(CpuSimulator, SameBitsWhateverTheThreadCount) {
   LightSpec light;
   light.direction = glm::normalize(glm::dvec3(0.3, -1.0, 0.2));
   light.power = {1.0, 0.7, 0.4};
+  // Free flight on a sharp sphere (the smoothed one has ∇n ≠ 0 in every voxel: nowhere quiet).
+  const Volume sharp = sharpVolume("procedural:sphere,r=0.5,ior=1.5", 20, cube(0.6));
+  for (const bool flight : {false, true}) {
   auto bake = [&](int threads) {
     ScopedThreads scope(threads);
-    CpuSimulator sim(v);
+    CpuSimulator sim(flight ? sharp : v);
     SimulationOptions o;
     o.max_depth = 5;  // fewer patches, same machinery
+    o.free_flight = flight;
     return sim.run(light, o);
   };
   const BakeResult one = bake(1), two = bake(2), three = bake(3);
+  EXPECT_EQ(one.stats.flights > 0, flight);
   EXPECT_EQ(one.stats.renderer, "cpu, 1 thread");
   EXPECT_EQ(two.stats.renderer, "cpu, 2 threads");
   for (const BakeResult* other : {&two, &three}) {
@@ -578,8 +583,10 @@ TEST(CpuSimulator, SameBitsWhateverTheThreadCount) {
     EXPECT_EQ(one.stats.flux_reflected, other->stats.flux_reflected);
     EXPECT_EQ(one.stats.total_patches, other->stats.total_patches);
     EXPECT_EQ(one.stats.splits, other->stats.splits);
+    EXPECT_EQ(one.stats.flights, other->stats.flights);
   }
   EXPECT_GT(one.stats.splits, 0u);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -69,6 +69,11 @@ int run(int argc, char** argv) {
                  "hat: flat in free air) or point (the first release: all of it at the voxel of the patch's "
                  "midpoint; no receiver map with it on the GPU)")
       ->check(CLI::IsMember({"track", "point"}));
+  std::string free_flight = "on";
+  app.add_option("--free-flight", free_flight,
+                 "on (default: the CPU twin crosses quiet space, where n is constant and no interface lies, in one "
+                 "straight step; the same bake in fewer steps) or off (steps of --step everywhere, as the GPU path)")
+      ->check(CLI::IsMember({"on", "off"}));
   app.add_option("--backend", backend,
                  "auto (default: gl on a hardware GPU for what the GPU path does, cpu otherwise), gl (the GPU "
                  "particle system) or cpu (the CPU twin, multi-threaded)")
@@ -136,6 +141,7 @@ int run(int argc, char** argv) {
   options.at_max_depth = at_max_depth == "kill" ? DepthLimit::Kill : DepthLimit::Keep;
   options.integrator = integrator == "rk4" ? Integrator::RK4 : integrator == "rk2" ? Integrator::RK2 : Integrator::Euler;
   options.deposit_kernel = kernel == "point" ? DepositKernel::Point : DepositKernel::Track;
+  options.free_flight = free_flight == "on";
   if (!receiver_text.empty() && no_receiver)
     throw InputError("command line", "--no-receiver", "give --receiver or --no-receiver, not both");
   if (!receiver_text.empty()) {

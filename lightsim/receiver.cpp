@@ -87,20 +87,20 @@ double polygonArea(const glm::dvec2* p, int count) {
 }
 
 void depositTriangle(const ReceiverMap& map, const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c,
-                     const glm::dvec3& flux, std::vector<glm::dvec3>& texel_flux) {
+                     const glm::dvec3& flux, std::vector<glm::dvec3>& texel_flux, int row_begin, int row_end) {
   const double area = 0.5 * std::abs(cross2(b - a, c - a));
   if (!(area > 0.0)) {
     // A degenerate footprint (all corners on a line or a point): its flux goes to the texel of its centre.
     const glm::dvec2 t = ((a + b + c) / 3.0 - map.origin) / map.pitch;
     const int i = static_cast<int>(std::floor(t.x)), j = static_cast<int>(std::floor(t.y));
-    if (i >= 0 && j >= 0 && i < map.texels.x && j < map.texels.y)
+    if (i >= 0 && j >= std::max(0, row_begin) && i < map.texels.x && j < std::min(map.texels.y, row_end))
       texel_flux[static_cast<std::size_t>(j) * static_cast<std::size_t>(map.texels.x) + static_cast<std::size_t>(i)] += flux;
     return;
   }
   const glm::dvec2 lo = (glm::min(a, glm::min(b, c)) - map.origin) / map.pitch;
   const glm::dvec2 hi = (glm::max(a, glm::max(b, c)) - map.origin) / map.pitch;
-  const int j0 = std::max(0, static_cast<int>(std::floor(lo.y)));
-  const int j1 = std::min(map.texels.y - 1, static_cast<int>(std::floor(hi.y)));
+  const int j0 = std::max(std::max(0, row_begin), static_cast<int>(std::floor(lo.y)));
+  const int j1 = std::min(std::min(map.texels.y, row_end) - 1, static_cast<int>(std::floor(hi.y)));
   const glm::dvec3 density = flux / area;
   // Edge functions, positive inside (whatever the winding): a texel with its four corners inside
   // all three is covered whole, one with its four corners outside one of them not at all; only the
@@ -155,13 +155,13 @@ double triangleSquareOverlap(const glm::dvec2& a, const glm::dvec2& b, const glm
 }
 
 void depositFootprint(const ReceiverMap& map, const std::array<glm::dvec2, 4>& f, const glm::dvec3& flux,
-                      std::vector<glm::dvec3>& texel_flux) {
+                      std::vector<glm::dvec3>& texel_flux, int row_begin, int row_end) {
   const double a1 = 0.5 * std::abs(cross2(f[1] - f[0], f[2] - f[0]));
   const double a2 = 0.5 * std::abs(cross2(f[2] - f[0], f[3] - f[0]));
   const double total = a1 + a2;
   const double share = total > 0.0 ? a1 / total : 0.5;
-  depositTriangle(map, f[0], f[1], f[2], flux * share, texel_flux);
-  depositTriangle(map, f[0], f[2], f[3], flux * (1.0 - share), texel_flux);
+  depositTriangle(map, f[0], f[1], f[2], flux * share, texel_flux, row_begin, row_end);
+  depositTriangle(map, f[0], f[2], f[3], flux * (1.0 - share), texel_flux, row_begin, row_end);
 }
 
 }  // namespace eik

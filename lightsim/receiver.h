@@ -11,6 +11,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -43,8 +44,11 @@ bool patchFootprint(const Patch& patch, const ReceiverMap& map, std::array<glm::
 // per-texel flux sums `texel_flux` (W, texelCount() long): split into the triangles (0, 1, 2) and
 // (0, 2, 3), each taking Φ·|its area|/(|area 1| + |area 2|) (a fold or twist keeps its flux), each
 // clipped exactly against every texel it touches. Flux falling outside the map is dropped.
+// Only the texel rows [row_begin, row_end) are written (each row's share is computed the same way
+// whatever the range), so that bands of rows can be filled in parallel with the same sums.
 void depositFootprint(const ReceiverMap& map, const std::array<glm::dvec2, 4>& footprint, const glm::dvec3& flux,
-                      std::vector<glm::dvec3>& texel_flux);
+                      std::vector<glm::dvec3>& texel_flux, int row_begin = 0,
+                      int row_end = std::numeric_limits<int>::max());
 
 // Area of the intersection of triangle (a, b, c) with the axis-aligned square [lo, hi] (exact,
 // Sutherland–Hodgman clipping).

@@ -74,6 +74,11 @@ struct SimulationOptions {
   DepthLimit at_max_depth = DepthLimit::Keep;
   double flux_threshold = 1e-4;   // kill below this fraction of the largest initial patch flux / 4^depth
   int max_steps = 0;              // 0: 4 × the grid diagonal in steps
+  // Free flight (ALGORITHM.md "Free flight"): a patch whose swept box is quiet (quiet_map.h) takes
+  // one straight step across it instead of steps of Δt. Needs the track kernel (accumulate);
+  // ignored otherwise. The CPU twin only: the GPU path steps by Δt everywhere. `lightsim` turns it
+  // on (--free-flight); off here so that the twin and the GPU path compare step for step.
+  bool free_flight = false;
   double boundary_on = 0.02;      // |∇n|·h entering a boundary layer (Fresnel tracking)
   double boundary_off = 0.01;     // |∇n|·h leaving it
   ProgressFn progress;            // fraction of the entering flux retired (dead or exited)
@@ -107,6 +112,7 @@ struct SimulationStats {
   glm::dvec3 flux_blocked{0.0};      // stopped by opaque materials
   std::uint64_t reflections = 0;     // reflected wavefronts followed (bounces)
   std::uint64_t rollbacks = 0;       // steps undone to split a patch torn by an interface
+  std::uint64_t flights = 0;         // patch-steps taken as free flights (longer than Δt)
   std::map<std::string, double> phase_seconds;   // "init", "update", "analysis", "compact", "deposit", "readback", ...
   // |flux_in − (out + absorbed + reflected + killed + unfinished + received + blocked)| over the
   // largest channel of flux_in, worst channel: 0 for an exact ledger.

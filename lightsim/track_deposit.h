@@ -50,11 +50,11 @@ inline HatWeights hatWeights(const glm::dvec3& p, const glm::ivec3& dims) {
   return hw;
 }
 
-// Calls visit(voxel_index, weight) for the hats along the segment a → b (continuous voxel
-// coordinates): the weights are ∫ K_v ds / |b − a|, exactly, and sum to 1 over all voxels (those
-// outside the grid are not visited). A voxel may be visited more than once.
+namespace detail {
+// forEachTrackWeight on a segment that crosses at most kMaxBreaks planes through voxel centres;
+// every weight is multiplied by `scale`.
 template <typename Visit>
-void forEachTrackWeight(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec3& dims, Visit&& visit) {
+void trackWeightsShort(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec3& dims, double scale, Visit&& visit) {
   // Parameters in (0, 1) where the segment crosses a plane through voxel centres: at most
   // 3 + Σ|b − a| of them.
   constexpr int kMaxBreaks = 64;
@@ -88,9 +88,33 @@ void forEachTrackWeight(const glm::dvec3& a, const glm::dvec3& b, const glm::ive
     for (const double node : {0.5 - kGauss, 0.5 + kGauss}) {
       const HatWeights hw = hatWeights(a + (t0 + node * length) * delta, dims);
       for (std::size_t k = 0; k < 8; ++k)
-        if (hw.index[k] >= 0 && hw.weight[k] != 0.0) visit(hw.index[k], 0.5 * length * hw.weight[k]);
+        if (hw.index[k] >= 0 && hw.weight[k] != 0.0) visit(hw.index[k], scale * (0.5 * length * hw.weight[k]));
     }
   }
+}
+}  // namespace detail
+
+// Calls visit(voxel_index, weight) for the hats along the segment a → b (continuous voxel
+// coordinates): the weights are ∫ K_v ds / |b − a|, exactly, and sum to 1 over all voxels (those
+// outside the grid are not visited). A voxel may be visited more than once. A long segment (a free
+// flight) is cut into equal pieces of at most 48 voxels of Σ|b − a| each (exact too: each piece is
+// integrated exactly); one wholly beyond the hats' reach (−½ and dims + ½ along some axis) visits
+// nothing.
+template <typename Visit>
+void forEachTrackWeight(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec3& dims, Visit&& visit) {
+  for (int axis = 0; axis < 3; ++axis)
+    if (std::max(a[axis], b[axis]) <= -0.5 || std::min(a[axis], b[axis]) >= dims[axis] + 0.5) return;
+  const glm::dvec3 delta = b - a;
+  const double span = std::fabs(delta.x) + std::fabs(delta.y) + std::fabs(delta.z);
+  constexpr double kPiece = 48.0;
+  if (!(span > kPiece)) {
+    detail::trackWeightsShort(a, b, dims, 1.0, visit);
+    return;
+  }
+  const int pieces = static_cast<int>(std::ceil(span / kPiece));
+  for (int i = 0; i < pieces; ++i)
+    detail::trackWeightsShort(a + (static_cast<double>(i) / pieces) * delta, a + (static_cast<double>(i + 1) / pieces) * delta,
+                              dims, 1.0 / pieces, visit);
 }
 
 // Sub-paths across a patch along one of its parameter directions: n = ceil(edge / ½ voxel) of them

@@ -142,6 +142,8 @@ glm::dvec4 VolumeSampler::materialOptics(int slot, const glm::dvec3& world) cons
   return interpolate<glm::dvec4>(ior_grad_, grid_, taps3(grid_, world, grid_.extent()));
 }
 
+QuietMap VolumeSampler::quietMap() const { return QuietMap(grid_, ior_grad_, distances_, table_, sigma_a_); }
+
 glm::dvec3 VolumeSampler::interfaceNormal(int slot, const glm::dvec3& world) const {
   const glm::dvec3 h = 0.5 * grid_.voxelSize();
   glm::dvec3 g;

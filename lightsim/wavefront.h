@@ -22,6 +22,7 @@
 
 #include "core/grid.h"
 #include "core/interfaces.h"
+#include "lightsim/quiet_map.h"
 #include "core/volume.h"
 #include "lightsim/simulator.h"
 
@@ -123,6 +124,8 @@ class VolumeSampler {
   // The outward unit normal of slot k's surface near `world`: ∇d_k by central differences of half a
   // voxel; (0, 0, 0) where the distance is flat (far outside the band).
   glm::dvec3 interfaceNormal(int slot, const glm::dvec3& world) const;
+  // The bricks where a straight step is exact (quiet_map.h), built from the fields held here.
+  QuietMap quietMap() const;
 
  private:
   GridSpec grid_;

@@ -1,0 +1,115 @@
+#include "lightsim/quiet_map.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace eik {
+
+namespace {
+
+// What a voxel contributes to a sample: equal signatures give equal optics.
+struct Signature {
+  int signs = 0;       // bit k: slot distance k < 0 (sharp interfaces only)
+  float n = 0.0f;      // n (compared only where it is used: smoothed volumes and graded slots)
+  bool uses_n = true;
+  glm::vec3 sigma{0.0f};
+  bool noisy = false;  // noisy by itself
+  bool operator==(const Signature& o) const {
+    return signs == o.signs && uses_n == o.uses_n && (!uses_n || n == o.n) && sigma == o.sigma;
+  }
+};
+
+}  // namespace
+
+QuietMap::QuietMap(const GridSpec& grid, const std::vector<glm::vec4>& ior_grad, const std::vector<glm::vec4>& distances,
+                   const InterfaceTable& table, const std::vector<glm::vec3>& sigma_a)
+    : grid_(grid) {
+  const glm::ivec3 d = grid.dims;
+  if (d.x <= 0 || d.y <= 0 || d.z <= 0 || ior_grad.size() != grid.count()) return;
+  bricks_ = (d + (kBrick - 1)) / kBrick;
+  const bool sharp = !table.empty() && distances.size() == grid.count();
+  const int slots = sharp ? static_cast<int>(table.slots.size()) : 0;
+  auto signature = [&](std::size_t v) {
+    Signature s;
+    const glm::vec4& g = ior_grad[v];
+    bool graded = true;  // the n and ∇n fields are what a sample returns
+    if (sharp) {
+      const glm::vec4& dist = distances[v];
+      int material = -1;
+      for (int k = 0; k < slots; ++k) {
+        if (dist[k] == 0.0f) s.noisy = true;
+        if (dist[k] < 0.0f) {
+          s.signs |= 1 << k;
+          if (material < 0) material = k;
+        }
+      }
+      graded = material >= 0 && table.slots[static_cast<std::size_t>(material)].graded;
+    }
+    s.uses_n = graded;
+    if (graded) {
+      s.n = g.x;
+      if (g.y != 0.0f || g.z != 0.0f || g.w != 0.0f) s.noisy = true;
+    }
+    if (!sigma_a.empty()) s.sigma = sigma_a[v];
+    return s;
+  };
+  std::vector<std::uint8_t> flag(static_cast<std::size_t>(bricks_.x) * bricks_.y * bricks_.z, 0);
+  auto brick = [&](int x, int y, int z) -> std::uint8_t& {
+    return flag[static_cast<std::size_t>(x / kBrick) +
+                static_cast<std::size_t>(bricks_.x) *
+                    (static_cast<std::size_t>(y / kBrick) + static_cast<std::size_t>(bricks_.y) * static_cast<std::size_t>(z / kBrick))];
+  };
+  for (int z = 0; z < d.z; ++z)
+    for (int y = 0; y < d.y; ++y)
+      for (int x = 0; x < d.x; ++x) {
+        const Signature s = signature(grid.index(x, y, z));
+        if (s.noisy) brick(x, y, z) = 1;
+        const int nx[3] = {x + 1, x, x}, ny[3] = {y, y + 1, y}, nz[3] = {z, z, z + 1};
+        for (int a = 0; a < 3; ++a) {
+          if (nx[a] >= d.x || ny[a] >= d.y || nz[a] >= d.z) continue;
+          if (!(signature(grid.index(nx[a], ny[a], nz[a])) == s)) {
+            brick(x, y, z) = 1;
+            brick(nx[a], ny[a], nz[a]) = 1;
+          }
+        }
+      }
+  const std::size_t sx = static_cast<std::size_t>(bricks_.x) + 1, sy = static_cast<std::size_t>(bricks_.y) + 1;
+  sat_.assign(sx * sy * (static_cast<std::size_t>(bricks_.z) + 1), 0);
+  for (int k = 1; k <= bricks_.z; ++k)
+    for (int j = 1; j <= bricks_.y; ++j)
+      for (int i = 1; i <= bricks_.x; ++i) {
+        const std::uint32_t f =
+            flag[static_cast<std::size_t>(i - 1) +
+                 static_cast<std::size_t>(bricks_.x) * (static_cast<std::size_t>(j - 1) + static_cast<std::size_t>(bricks_.y) * (k - 1))];
+        noisy_ += f;
+        auto at = [&](int a, int b, int c) -> std::uint32_t& {
+          return sat_[static_cast<std::size_t>(a) + sx * (static_cast<std::size_t>(b) + sy * static_cast<std::size_t>(c))];
+        };
+        at(i, j, k) = f + at(i - 1, j, k) + at(i, j - 1, k) + at(i, j, k - 1) - at(i - 1, j - 1, k) - at(i - 1, j, k - 1) -
+                      at(i, j - 1, k - 1) + at(i - 1, j - 1, k - 1);
+      }
+}
+
+bool QuietMap::quiet(const glm::dvec3& lo, const glm::dvec3& hi) const {
+  if (sat_.empty()) return false;
+  int b0[3], b1[3];
+  const glm::dvec3 qlo = grid_.toVoxel(lo), qhi = grid_.toVoxel(hi);
+  for (int a = 0; a < 3; ++a) {
+    if (!std::isfinite(qlo[a]) || !std::isfinite(qhi[a])) return false;
+    // The taps of a sample at voxel coordinate q (centres at i + ½): floor(c) and floor(c) + 1 with
+    // c = q − ½ clamped to [0, dims − 1] (trilinearTaps).
+    const double top = grid_.dims[a] - 1;
+    const double c0 = std::clamp(std::min(qlo[a], qhi[a]) - 0.5, 0.0, top);
+    const double c1 = std::clamp(std::max(qlo[a], qhi[a]) - 0.5, 0.0, top);
+    const int v0 = static_cast<int>(std::floor(c0));
+    const int v1 = std::min(grid_.dims[a] - 1, static_cast<int>(std::floor(c1)) + 1);
+    b0[a] = v0 / kBrick;
+    b1[a] = v1 / kBrick + 1;  // exclusive
+  }
+  const std::uint32_t count = sat(b1[0], b1[1], b1[2]) - sat(b0[0], b1[1], b1[2]) - sat(b1[0], b0[1], b1[2]) -
+                              sat(b1[0], b1[1], b0[2]) + sat(b0[0], b0[1], b1[2]) + sat(b0[0], b1[1], b0[2]) +
+                              sat(b1[0], b0[1], b0[2]) - sat(b0[0], b0[1], b0[2]);
+  return count == 0;
+}
+
+}  // namespace eik

@@ -1,0 +1,60 @@
+// Where a straight step is exact: the quiet bricks of a volume (ALGORITHM.md "Free flight").
+//
+// A region is quiet when every trilinear sample in it gives one material with constant optics: the
+// same interface signs (with sharp interfaces), ∇n = 0, and the same n and σa. There the ray
+// equation (Eq. 4.12/4.13) has straight solutions, x(t) = x₀ + t·w/n², with w and Φ's absorption
+// rate constant, so a patch can cross the region in one step of any length and its track deposits
+// (track_deposit.h, exact along straight sub-paths) do not change.
+//
+// The map keeps one flag per brick of kBrick³ voxels: noisy when a voxel in it is noisy itself
+// (∇n ≠ 0, a distance exactly 0, a graded material) or differs from a face neighbour, in which
+// case both bricks are noisy. A box of voxels without a noisy brick holds one signature (it is
+// connected through face neighbours, none of which differ), and a summed-area table over the flags
+// answers "is this box quiet?" with eight lookups.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/grid.h"
+#include "core/interfaces.h"
+
+namespace eik {
+
+class QuietMap {
+ public:
+  static constexpr int kBrick = 4;  // voxels per brick edge
+
+  QuietMap() = default;
+  // The fields as VolumeSampler holds them: (n, ∇n) per voxel; the four slot distances per voxel
+  // (empty without sharp interfaces) with their table; σa per voxel (empty: none).
+  QuietMap(const GridSpec& grid, const std::vector<glm::vec4>& ior_grad, const std::vector<glm::vec4>& distances,
+           const InterfaceTable& table, const std::vector<glm::vec3>& sigma_a);
+
+  // Does every trilinear sample (GL_LINEAR, clamp-to-edge) at a point of the world box [lo, hi]
+  // see the same material with constant optics? Points outside the grid sample its edge voxels,
+  // so a box beyond the grid is quiet when the edge voxels it clamps to are. False for a box that
+  // is not finite.
+  bool quiet(const glm::dvec3& lo, const glm::dvec3& hi) const;
+
+  bool empty() const { return sat_.empty(); }
+  glm::ivec3 bricks() const { return bricks_; }
+  std::size_t noisyBricks() const { return noisy_; }
+
+ private:
+  GridSpec grid_;
+  glm::ivec3 bricks_{0};
+  std::size_t noisy_ = 0;
+  // Summed-area table of the noisy flags, (bricks + 1)³ entries; entry (i, j, k) counts the noisy
+  // bricks with indices below (i, j, k).
+  std::vector<std::uint32_t> sat_;
+  std::uint32_t sat(int i, int j, int k) const {
+    return sat_[static_cast<std::size_t>(i) +
+                static_cast<std::size_t>(bricks_.x + 1) *
+                    (static_cast<std::size_t>(j) + static_cast<std::size_t>(bricks_.y + 1) * static_cast<std::size_t>(k))];
+  }
+};
+
+}  // namespace eik

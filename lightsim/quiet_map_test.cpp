@@ -1,0 +1,112 @@
+// The quiet map (quiet_map.h): a box it calls quiet must give one material with constant optics at
+// every point, checked by sampling the volume itself at random points of random boxes; boxes across
+// an interface, a gradient or an absorption edge are never quiet; space well away from them is.
+#include "lightsim/quiet_map.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "lightsim/test_scenes.h"
+#include "lightsim/wavefront.h"
+
+namespace eik {
+namespace {
+
+using namespace test_scenes;
+
+// Samples `samples` random points of each of `boxes` random boxes (edges up to 8 voxels, centres
+// anywhere in the grid grown by 4 voxels); for every box the map calls quiet, every sample must see
+// the material, n, ∇n and σa of the box's centre. Returns how many boxes were quiet.
+int checkQuietBoxesAreUniform(const VolumeSampler& sampler, const QuietMap& map, int boxes, int samples) {
+  std::mt19937 rng(12345);
+  const GridSpec& g = sampler.grid();
+  const double h = sampler.h();
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int quiet = 0;
+  for (int b = 0; b < boxes; ++b) {
+    glm::dvec3 centre, half;
+    for (int a = 0; a < 3; ++a) {
+      centre[a] = g.bounds_min[a] - 4.0 * h + unit(rng) * (g.extent()[a] + 8.0 * h);
+      half[a] = unit(rng) * 4.0 * h;
+    }
+    if (!map.quiet(centre - half, centre + half)) continue;
+    ++quiet;
+    const int material = sampler.materialAt(centre);
+    const glm::dvec4 optics = sampler.iorAndGradient(centre);
+    const glm::dvec3 sigma = sampler.hasAbsorption() ? sampler.sigmaA(centre) : glm::dvec3(0.0);
+    EXPECT_EQ(optics.y, 0.0);
+    EXPECT_EQ(optics.z, 0.0);
+    EXPECT_EQ(optics.w, 0.0);
+    for (int s = 0; s < samples; ++s) {
+      glm::dvec3 p;
+      for (int a = 0; a < 3; ++a) p[a] = centre[a] + (2.0 * unit(rng) - 1.0) * half[a];
+      // Trilinear weights of equal values sum to the value within a few ulps.
+      const glm::dvec4 o = sampler.iorAndGradient(p);
+      const bool same = sampler.materialAt(p) == material && std::fabs(o.x - optics.x) < 1e-12 &&
+                        glm::dvec3(o.y, o.z, o.w) == glm::dvec3(0.0) &&
+                        (!sampler.hasAbsorption() || glm::length(sampler.sigmaA(p) - sigma) < 1e-12);
+      EXPECT_TRUE(same) << "box " << b << " sample " << s;
+      if (!same) return quiet;
+    }
+  }
+  return quiet;
+}
+
+TEST(QuietMap, SharpSphereQuietBoxesAreUniformAndTheSurfaceIsNot) {
+  const Volume volume = sharpVolume("procedural:sphere,r=0.5,ior=1.5", 32, cube(0.8));
+  const VolumeSampler sampler(volume);
+  const QuietMap map = sampler.quietMap();
+  ASSERT_FALSE(map.empty());
+  EXPECT_GT(map.noisyBricks(), 0u);
+  const int quiet = checkQuietBoxesAreUniform(sampler, map, 4000, 40);
+  // Most of the grid is air or the sphere's inside, away from its surface (a band of noisy bricks
+  // about one brick thick): well over a tenth of random boxes must be quiet, or the map is useless.
+  EXPECT_GT(quiet, 400);
+  const double h = sampler.h();
+  // A box astride the surface, anywhere on it, and a tiny one on it.
+  for (const glm::dvec3 dir : {glm::dvec3(1, 0, 0), glm::dvec3(0, -1, 0), glm::normalize(glm::dvec3(1, 1, -1))}) {
+    const glm::dvec3 on = 0.5 * dir;
+    EXPECT_FALSE(map.quiet(on - 2.0 * h, on + 2.0 * h));
+    EXPECT_FALSE(map.quiet(on - 0.01 * h, on + 0.01 * h));
+  }
+  // A segment from the air through the sphere is not quiet; the sphere's core and the grid's
+  // corner (more than two bricks from the surface) are.
+  EXPECT_FALSE(map.quiet(glm::dvec3(-0.05, -0.75, -0.05), glm::dvec3(0.05, 0.75, 0.05)));
+  EXPECT_TRUE(map.quiet(glm::dvec3(-0.1), glm::dvec3(0.1)));
+  EXPECT_TRUE(map.quiet(glm::dvec3(0.65), glm::dvec3(0.78)));
+  // Beyond the grid, samples clamp to its edge voxels: air there, so quiet however far.
+  EXPECT_TRUE(map.quiet(glm::dvec3(0.9, -3.0, 0.9), glm::dvec3(5.0, 3.0, 5.0)));
+  EXPECT_FALSE(map.quiet(glm::dvec3(-0.1, -9.0, -0.1), glm::dvec3(0.1, 9.0, 0.1)));  // clamps across the sphere
+  EXPECT_FALSE(map.quiet(glm::dvec3(0.0), glm::dvec3(std::numeric_limits<double>::infinity())));
+}
+
+TEST(QuietMap, SmoothedSphereQuietBoxesHaveNoGradient) {
+  const Volume volume = glassSphere(32, cube(0.8));
+  const VolumeSampler sampler(volume);
+  const QuietMap map = sampler.quietMap();
+  const int quiet = checkQuietBoxesAreUniform(sampler, map, 4000, 40);
+  EXPECT_GT(quiet, 200);
+  // The smoothed boundary layer (∇n ≠ 0 over a few voxels) is never quiet.
+  const double h = sampler.h();
+  EXPECT_FALSE(map.quiet(glm::dvec3(0.5 - h, 0.0, 0.0), glm::dvec3(0.5 + h, 0.01, 0.01)));
+  EXPECT_TRUE(map.quiet(glm::dvec3(0.66), glm::dvec3(0.78)));
+}
+
+TEST(QuietMap, AbsorptionEdgesAreNotQuietAndUniformAbsorptionIs) {
+  const Bounds bounds = cube(0.5);
+  const Volume absorbing = slab(32, bounds, -0.1, 0.2, 1.0, glm::dvec3(2.0, 1.0, 0.5));
+  const VolumeSampler sampler(absorbing);
+  ASSERT_TRUE(sampler.hasAbsorption());
+  const QuietMap map = sampler.quietMap();
+  checkQuietBoxesAreUniform(sampler, map, 2000, 20);
+  EXPECT_FALSE(map.quiet(glm::dvec3(-0.1, 0.05, -0.1), glm::dvec3(0.1, 0.15, 0.1)));  // the slab's top
+  const Volume uniform = uniformVolume(cubicGrid(16, 0.5), 1.33, glm::dvec3(0.5));
+  const VolumeSampler uniform_sampler(uniform);
+  const QuietMap all = uniform_sampler.quietMap();
+  EXPECT_EQ(all.noisyBricks(), 0u);
+  EXPECT_TRUE(all.quiet(glm::dvec3(-0.5), glm::dvec3(0.5)));
+}
+
+}  // namespace
+}  // namespace eik
