@@ -486,12 +486,19 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
 
 namespace {
 
+// The deposit targets of one voxel, together so that a deposit touches one place: irradiance
+// (W/m², RGB) and the luminance-weighted direction sum, in double (accumulate) or the strongest
+// patch so far (max).
+struct DepositSum {
+  glm::dvec3 irradiance{0.0};
+  glm::dvec3 direction{0.0};
+};
+
 // The track deposits of one step (track_deposit.h), applied by slabs of z-slices in parallel: a
 // voxel belongs to one slab, whose thread adds the sub-paths in patch order, so the sums do not
 // depend on the thread count.
 void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<PatchStepResult>& results,
-                        const GridSpec& grid, const ReceiverMap* receiver, std::vector<glm::dvec3>& irradiance,
-                        std::vector<glm::dvec3>& direction, std::vector<std::vector<std::uint32_t>>& by_slab) {
+                        const GridSpec& grid, const ReceiverMap* receiver, std::vector<DepositSum>& sums, std::vector<std::vector<std::uint32_t>>& by_slab) {
   const std::size_t count = results.size();
   const glm::dvec3 h = grid.voxelSize();
   const double inv_volume = 1.0 / grid.voxelVolume();
@@ -565,8 +572,9 @@ void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<Pat
           forEachTrackWeight(va, vb, grid.dims, [&](long long v, double w) {
             const std::size_t at = static_cast<std::size_t>(v);
             if (at - lo >= hi - lo) return;  // another slab's voxel (unsigned: also below lo)
-            irradiance[at] += e * w;
-            direction[at] += dsum * w;
+            DepositSum& sum = sums[at];
+            sum.irradiance += e * w;
+            sum.direction += dsum * w;
           });
         }
     }
@@ -615,8 +623,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   const bool track = accumulate && options.deposit_kernel == DepositKernel::Track;
 
   // Deposit targets, in double (accumulate) or the strongest patch so far (max).
-  std::vector<glm::dvec3> irradiance(patches.empty() ? 0 : voxels, glm::dvec3(0.0));
-  std::vector<glm::dvec3> direction(patches.empty() ? 0 : voxels, glm::dvec3(0.0));
+  std::vector<DepositSum> sums(patches.empty() ? 0 : voxels);
   std::vector<double> best_key(accumulate || patches.empty() ? 0 : voxels, -1.0);
 
   std::vector<PatchSamples> samples(patches.size());
@@ -653,7 +660,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
 
     // Deposits and the ledger, in patch order (deterministic sums).
     t.restart();
-    if (track) applyTrackDeposits(patches, results, grid, ctx.receiver, irradiance, direction, slab_lists);
+    if (track) applyTrackDeposits(patches, results, grid, ctx.receiver, sums, slab_lists);
     offsets.resize(count + 1);
     std::uint64_t total = 0;
     for (std::size_t i = 0; i < count; ++i) {
@@ -666,12 +673,12 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
       if (r.voxel >= 0) {
         const std::size_t v = static_cast<std::size_t>(r.voxel);
         if (accumulate) {
-          irradiance[v] += r.deposit;
-          direction[v] += r.deposit_dir;
+          sums[v].irradiance += r.deposit;
+          sums[v].direction += r.deposit_dir;
         } else if (r.max_key > best_key[v]) {
           best_key[v] = r.max_key;
-          irradiance[v] = r.deposit;
-          direction[v] = r.deposit_dir;
+          sums[v].irradiance = r.deposit;
+          sums[v].direction = r.deposit_dir;
         }
       }
       offsets[i] = total;
@@ -783,17 +790,17 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   bake.irradiance.data.assign(voxels * 3, 0.0f);
   bake.light_dir.components = 3;
   bake.light_dir.data.assign(voxels * 3, 0.0f);
-  if (!irradiance.empty()) {
+  if (!sums.empty()) {
     parallelFor(
         0, static_cast<std::int64_t>(voxels),
         [&](std::int64_t v64) {
           const std::size_t v = static_cast<std::size_t>(v64);
           float* e = bake.irradiance.voxel(v);
           float* d = bake.light_dir.voxel(v);
-          for (int c = 0; c < 3; ++c) e[c] = static_cast<float>(irradiance[v][c]);
-          const double len = glm::length(direction[v]);
+          for (int c = 0; c < 3; ++c) e[c] = static_cast<float>(sums[v].irradiance[c]);
+          const double len = glm::length(sums[v].direction);
           if (len > 0.0)
-            for (int c = 0; c < 3; ++c) d[c] = static_cast<float>(direction[v][c] / len);
+            for (int c = 0; c < 3; ++c) d[c] = static_cast<float>(sums[v].direction[c] / len);
         },
         4096);
   }

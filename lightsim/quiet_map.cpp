@@ -26,7 +26,8 @@ QuietMap::QuietMap(const GridSpec& grid, const std::vector<glm::vec4>& ior_grad,
     : grid_(grid) {
   const glm::ivec3 d = grid.dims;
   if (d.x <= 0 || d.y <= 0 || d.z <= 0 || ior_grad.size() != grid.count()) return;
-  bricks_ = (d + (kBrick - 1)) / kBrick;
+  brick_ = std::max(d.x, std::max(d.y, d.z)) > 512 ? 4 : 2;
+  bricks_ = (d + (brick_ - 1)) / brick_;
   const bool sharp = !table.empty() && distances.size() == grid.count();
   const int slots = sharp ? static_cast<int>(table.slots.size()) : 0;
   auto signature = [&](std::size_t v) {
@@ -55,9 +56,9 @@ QuietMap::QuietMap(const GridSpec& grid, const std::vector<glm::vec4>& ior_grad,
   };
   std::vector<std::uint8_t> flag(static_cast<std::size_t>(bricks_.x) * bricks_.y * bricks_.z, 0);
   auto brick = [&](int x, int y, int z) -> std::uint8_t& {
-    return flag[static_cast<std::size_t>(x / kBrick) +
+    return flag[static_cast<std::size_t>(x / brick_) +
                 static_cast<std::size_t>(bricks_.x) *
-                    (static_cast<std::size_t>(y / kBrick) + static_cast<std::size_t>(bricks_.y) * static_cast<std::size_t>(z / kBrick))];
+                    (static_cast<std::size_t>(y / brick_) + static_cast<std::size_t>(bricks_.y) * static_cast<std::size_t>(z / brick_))];
   };
   for (int z = 0; z < d.z; ++z)
     for (int y = 0; y < d.y; ++y)
@@ -103,8 +104,8 @@ bool QuietMap::quiet(const glm::dvec3& lo, const glm::dvec3& hi) const {
     const double c1 = std::clamp(std::max(qlo[a], qhi[a]) - 0.5, 0.0, top);
     const int v0 = static_cast<int>(std::floor(c0));
     const int v1 = std::min(grid_.dims[a] - 1, static_cast<int>(std::floor(c1)) + 1);
-    b0[a] = v0 / kBrick;
-    b1[a] = v1 / kBrick + 1;  // exclusive
+    b0[a] = v0 / brick_;
+    b1[a] = v1 / brick_ + 1;  // exclusive
   }
   const std::uint32_t count = sat(b1[0], b1[1], b1[2]) - sat(b0[0], b1[1], b1[2]) - sat(b1[0], b0[1], b1[2]) -
                               sat(b1[0], b1[1], b0[2]) + sat(b0[0], b0[1], b1[2]) + sat(b0[0], b1[1], b0[2]) +

@@ -6,7 +6,8 @@
 // rate constant, so a patch can cross the region in one step of any length and its track deposits
 // (track_deposit.h, exact along straight sub-paths) do not change.
 //
-// The map keeps one flag per brick of kBrick³ voxels: noisy when a voxel in it is noisy itself
+// The map keeps one flag per brick of b³ voxels (b = 2, or 4 for grids over 512 voxels an axis, so
+// that the table stays under 32 M entries): noisy when a voxel in it is noisy itself
 // (∇n ≠ 0, a distance exactly 0, a graded material) or differs from a face neighbour, in which
 // case both bricks are noisy. A box of voxels without a noisy brick holds one signature (it is
 // connected through face neighbours, none of which differ), and a summed-area table over the flags
@@ -25,7 +26,6 @@ namespace eik {
 
 class QuietMap {
  public:
-  static constexpr int kBrick = 4;  // voxels per brick edge
 
   QuietMap() = default;
   // The fields as VolumeSampler holds them: (n, ∇n) per voxel; the four slot distances per voxel
@@ -41,10 +41,12 @@ class QuietMap {
 
   bool empty() const { return sat_.empty(); }
   glm::ivec3 bricks() const { return bricks_; }
+  int brickVoxels() const { return brick_; }  // voxels per brick edge
   std::size_t noisyBricks() const { return noisy_; }
 
  private:
   GridSpec grid_;
+  int brick_ = 2;
   glm::ivec3 bricks_{0};
   std::size_t noisy_ = 0;
   // Summed-area table of the noisy flags, (bricks + 1)³ entries; entry (i, j, k) counts the noisy

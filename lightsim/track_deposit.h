@@ -85,10 +85,22 @@ void trackWeightsShort(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec
     const double t0 = breaks[static_cast<std::size_t>(piece)], t1 = breaks[static_cast<std::size_t>(piece + 1)];
     const double length = t1 - t0;
     if (!(length > 0.0)) continue;
+    // A piece lies in one cell of the voxel-centre lattice, so both nodes share its eight hats:
+    // their weights are summed first and each hat visited once.
+    const glm::dvec3 base = glm::floor(a + (t0 + 0.5 * length) * delta - 0.5);
+    std::array<double, 8> weight{};
     for (const double node : {0.5 - kGauss, 0.5 + kGauss}) {
-      const HatWeights hw = hatWeights(a + (t0 + node * length) * delta, dims);
-      for (std::size_t k = 0; k < 8; ++k)
-        if (hw.index[k] >= 0 && hw.weight[k] != 0.0) visit(hw.index[k], scale * (0.5 * length * hw.weight[k]));
+      const glm::dvec3 t = glm::clamp(a + (t0 + node * length) * delta - 0.5 - base, 0.0, 1.0);
+      for (int k = 0; k < 8; ++k)
+        weight[static_cast<std::size_t>(k)] += ((k & 1) ? t.x : 1.0 - t.x) * ((k & 2) ? t.y : 1.0 - t.y) * ((k & 4) ? t.z : 1.0 - t.z);
+    }
+    const glm::ivec3 i0(base);
+    for (int k = 0; k < 8; ++k) {
+      const glm::ivec3 v = i0 + glm::ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+      const double w = weight[static_cast<std::size_t>(k)];
+      if (w == 0.0 || v.x < 0 || v.y < 0 || v.z < 0 || v.x >= dims.x || v.y >= dims.y || v.z >= dims.z) continue;
+      visit(static_cast<long long>(v.x) + static_cast<long long>(dims.x) * (static_cast<long long>(v.y) + static_cast<long long>(dims.y) * v.z),
+            scale * (0.5 * length * w));
     }
   }
 }
@@ -96,25 +108,38 @@ void trackWeightsShort(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec
 
 // Calls visit(voxel_index, weight) for the hats along the segment a → b (continuous voxel
 // coordinates): the weights are ∫ K_v ds / |b − a|, exactly, and sum to 1 over all voxels (those
-// outside the grid are not visited). A voxel may be visited more than once. A long segment (a free
-// flight) is cut into equal pieces of at most 48 voxels of Σ|b − a| each (exact too: each piece is
-// integrated exactly); one wholly beyond the hats' reach (−½ and dims + ½ along some axis) visits
-// nothing.
+// outside the grid are not visited). A voxel may be visited more than once. Only the part within
+// the hats' reach is integrated, and a long one (a free flight) in equal pieces of at most 48
+// voxels of Σ|b − a| each (exact too: each piece is integrated exactly).
 template <typename Visit>
 void forEachTrackWeight(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec3& dims, Visit&& visit) {
-  for (int axis = 0; axis < 3; ++axis)
-    if (std::max(a[axis], b[axis]) <= -0.5 || std::min(a[axis], b[axis]) >= dims[axis] + 0.5) return;
+  // The part of the segment within the hats' reach, (−½, dims + ½) along every axis: the rest
+  // visits nothing. A segment that leaves it (a flight out of the grid) is cut, its weights scaled
+  // by the share of the length kept.
   const glm::dvec3 delta = b - a;
-  const double span = std::fabs(delta.x) + std::fabs(delta.y) + std::fabs(delta.z);
+  double f0 = 0.0, f1 = 1.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double lo = -0.5, hi = dims[axis] + 0.5;
+    if (std::max(a[axis], b[axis]) <= lo || std::min(a[axis], b[axis]) >= hi) return;
+    if (a[axis] >= lo && a[axis] <= hi && b[axis] >= lo && b[axis] <= hi) continue;
+    const double g0 = (lo - a[axis]) / delta[axis], g1 = (hi - a[axis]) / delta[axis];
+    f0 = std::max(f0, std::min(g0, g1));
+    f1 = std::min(f1, std::max(g0, g1));
+  }
+  if (!(f1 > f0)) return;
+  const glm::dvec3 from = f0 > 0.0 ? a + f0 * delta : a, to = f1 < 1.0 ? a + f1 * delta : b;
+  const double kept = f1 - f0;
+  const glm::dvec3 span = to - from;
+  const double l1 = std::fabs(span.x) + std::fabs(span.y) + std::fabs(span.z);
   constexpr double kPiece = 48.0;
-  if (!(span > kPiece)) {
-    detail::trackWeightsShort(a, b, dims, 1.0, visit);
+  if (!(l1 > kPiece)) {
+    detail::trackWeightsShort(from, to, dims, kept, visit);
     return;
   }
-  const int pieces = static_cast<int>(std::ceil(span / kPiece));
+  const int pieces = static_cast<int>(std::ceil(l1 / kPiece));
   for (int i = 0; i < pieces; ++i)
-    detail::trackWeightsShort(a + (static_cast<double>(i) / pieces) * delta, a + (static_cast<double>(i + 1) / pieces) * delta,
-                              dims, 1.0 / pieces, visit);
+    detail::trackWeightsShort(from + (static_cast<double>(i) / pieces) * span,
+                              from + (static_cast<double>(i + 1) / pieces) * span, dims, kept / pieces, visit);
 }
 
 // Sub-paths across a patch along one of its parameter directions: n = ceil(edge / ½ voxel) of them
