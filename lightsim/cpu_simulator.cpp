@@ -635,6 +635,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   std::vector<std::vector<std::uint32_t>> slab_lists;
   std::vector<std::uint64_t> offsets;
   std::vector<std::uint32_t> received;  // this step's received patches
+  std::vector<std::vector<std::uint32_t>> band_lists;  // …and those whose footprint reaches each band of map rows
   std::vector<Patch> next;
   std::vector<PatchSamples> next_samples;
   double t_update = 0.0, t_deposit = 0.0, t_compact = 0.0;
@@ -728,9 +729,24 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
     if (!received.empty()) {
       constexpr int kBandRows = 16;
       const int bands = (receiver.texels.y + kBandRows - 1) / kBandRows;
+      band_lists.resize(static_cast<std::size_t>(bands));
+      for (auto& list : band_lists) list.clear();
+      for (const std::uint32_t i : received) {
+        // The rows the footprint's box covers, hence the bands that get a share.
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (const glm::dvec2& f : results[i].footprint) {
+          lo = std::min(lo, f.y);
+          hi = std::max(hi, f.y);
+        }
+        const double r0 = (lo - receiver.origin.y) / receiver.pitch, r1 = (hi - receiver.origin.y) / receiver.pitch;
+        if (!(r1 >= 0.0 && r0 < receiver.texels.y)) continue;  // wholly off the map (or not finite)
+        const int b0 = static_cast<int>(std::max(0.0, r0)) / kBandRows;
+        const int b1 = static_cast<int>(std::min(static_cast<double>(receiver.texels.y - 1), r1)) / kBandRows;
+        for (int b = b0; b <= b1; ++b) band_lists[static_cast<std::size_t>(b)].push_back(i);
+      }
       parallelFor(0, bands, [&](std::int64_t band) {
         const int row0 = static_cast<int>(band) * kBandRows;
-        for (const std::uint32_t i : received)
+        for (const std::uint32_t i : band_lists[static_cast<std::size_t>(band)])
           depositFootprint(receiver, results[i].footprint, results[i].received, receiver_flux, row0, row0 + kBandRows);
       });
       received.clear();

@@ -156,6 +156,37 @@ double triangleSquareOverlap(const glm::dvec2& a, const glm::dvec2& b, const glm
 
 void depositFootprint(const ReceiverMap& map, const std::array<glm::dvec2, 4>& f, const glm::dvec3& flux,
                       std::vector<glm::dvec3>& texel_flux, int row_begin, int row_end) {
+  // An axis-aligned rectangle (a patch straight down onto a level floor, as most of them are
+  // outside the volume): its two triangles have equal shares and one density, so each texel gets
+  // the density times the product of its overlaps along u and v.
+  const bool rect_u = f[0].y == f[1].y && f[1].x == f[2].x && f[2].y == f[3].y && f[3].x == f[0].x;
+  const bool rect_v = f[0].x == f[1].x && f[1].y == f[2].y && f[2].x == f[3].x && f[3].y == f[0].y;
+  if (rect_u || rect_v) {
+    const glm::dvec2 lo = glm::min(f[0], f[2]), hi = glm::max(f[0], f[2]);
+    const double area = (hi.x - lo.x) * (hi.y - lo.y);
+    if (area > 0.0) {
+      const glm::dvec3 density = flux / area;
+      const glm::dvec2 tlo = (lo - map.origin) / map.pitch, thi = (hi - map.origin) / map.pitch;
+      const int i0 = std::max(0, static_cast<int>(std::floor(std::max(tlo.x, -1.0))));
+      const int i1 = std::min(map.texels.x - 1, static_cast<int>(std::floor(std::min(thi.x, static_cast<double>(map.texels.x)))));
+      const int j0 = std::max(std::max(0, row_begin), static_cast<int>(std::floor(std::max(tlo.y, -1.0))));
+      const int j1 = std::min(std::min(map.texels.y, row_end) - 1,
+                              static_cast<int>(std::floor(std::min(thi.y, static_cast<double>(map.texels.y)))));
+      for (int j = j0; j <= j1; ++j) {
+        const double y0 = map.origin.y + j * map.pitch;
+        const double oy = std::min(hi.y, y0 + map.pitch) - std::max(lo.y, y0);
+        if (!(oy > 0.0)) continue;
+        for (int i = i0; i <= i1; ++i) {
+          const double x0 = map.origin.x + i * map.pitch;
+          const double ox = std::min(hi.x, x0 + map.pitch) - std::max(lo.x, x0);
+          if (ox > 0.0)
+            texel_flux[static_cast<std::size_t>(j) * static_cast<std::size_t>(map.texels.x) + static_cast<std::size_t>(i)] +=
+                density * (ox * oy);
+        }
+      }
+      return;
+    }
+  }
   const double a1 = 0.5 * std::abs(cross2(f[1] - f[0], f[2] - f[0]));
   const double a2 = 0.5 * std::abs(cross2(f[2] - f[0], f[3] - f[0]));
   const double total = a1 + a2;

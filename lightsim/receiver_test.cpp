@@ -33,6 +33,37 @@ ReceiverMap unitMap(int texels, double pitch) {
   return map;
 }
 
+// An axis-aligned rectangle takes depositFootprint's separable path; every texel must get the
+// flux its two triangles' exact overlaps give (triangleSquareOverlap), in either corner order and
+// orientation, and a rectangle reaching off the map loses only what lies off it.
+TEST(Receiver, AxisAlignedFootprintsGetTheirTrianglesExactShares) {
+  const ReceiverMap map = unitMap(12, 0.1);
+  for (const std::array<glm::dvec2, 4>& quad :
+       {std::array<glm::dvec2, 4>{{{0.05, -0.21}, {0.37, -0.21}, {0.37, 0.13}, {0.05, 0.13}}},
+        std::array<glm::dvec2, 4>{{{0.05, -0.21}, {0.05, 0.13}, {0.37, 0.13}, {0.37, -0.21}}},
+        std::array<glm::dvec2, 4>{{{0.37, 0.13}, {0.05, 0.13}, {0.05, -0.21}, {0.37, -0.21}}},
+        std::array<glm::dvec2, 4>{{{0.41, 0.31}, {0.93, 0.31}, {0.93, 0.77}, {0.41, 0.77}}}}) {
+    std::vector<glm::dvec3> flux(map.texelCount(), glm::dvec3(0.0));
+    const glm::dvec3 phi(2.0, 1.0, 0.5);
+    depositFootprint(map, quad, phi, flux);
+    const double area = std::abs((quad[2].x - quad[0].x) * (quad[2].y - quad[0].y));
+    double total = 0.0, expected_total = 0.0;
+    for (int j = 0; j < map.texels.y; ++j)
+      for (int i = 0; i < map.texels.x; ++i) {
+        const glm::dvec2 lo = map.origin + glm::dvec2(i, j) * map.pitch, hi = lo + glm::dvec2(map.pitch);
+        const double overlap = triangleSquareOverlap(quad[0], quad[1], quad[2], lo, hi) +
+                               triangleSquareOverlap(quad[0], quad[2], quad[3], lo, hi);
+        const glm::dvec3 got = flux[static_cast<std::size_t>(j * map.texels.x + i)];
+        EXPECT_NEAR(got.x, phi.x * overlap / area, 1e-12) << i << "," << j;
+        EXPECT_NEAR(got.z, phi.z * overlap / area, 1e-12) << i << "," << j;
+        total += got.x;
+        expected_total += phi.x * overlap / area;
+      }
+    EXPECT_NEAR(total, expected_total, 1e-12);
+    EXPECT_GT(total, 0.4);  // the last one lies 46 % on the map
+  }
+}
+
 TEST(Receiver, FootprintFluxIsConservedAndSpreadByArea) {
   const ReceiverMap map = unitMap(16, 0.1);
   std::vector<glm::dvec3> flux(map.texelCount(), glm::dvec3(0.0));

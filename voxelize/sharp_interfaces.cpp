@@ -179,7 +179,13 @@ Volume buildSharpVolume(const std::vector<Region>& regions, const GridSpec& grid
       }
   });
 
-  volume.metadata["interfaces"] = slots.table.toJson();
+  if (slot_count > 0) {
+    volume.metadata["interfaces"] = slots.table.toJson();
+  } else {
+    // Nothing needs an interface (only n = 1 objects, such as smoke): no table and no field, since
+    // a table of no slots is not a valid volume (core/interfaces.h) and n is 1 everywhere.
+    volume.fields.erase("interfaces");
+  }
   volume.metadata["ior_smoothing_sigma_voxels"] = 0.0;
   volume.metadata["ior_gradient"] = "graded materials only (sharp interfaces)";
   return volume;

@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "core/interfaces.h"
 #include "core/testing.h"
 #include "voxelize/grid_builder.h"
 #include "voxelize/pipeline.h"
@@ -83,6 +84,18 @@ TEST(SharpInterfaces, FieldsAreSharpDistancesAndUnblendedN) {
       }
   EXPECT_EQ(v.metadata.at("interfaces").at("slots").size(), 1u);
   EXPECT_EQ(v.metadata.at("ior_smoothing_sigma_voxels"), 0.0);
+}
+
+// Objects that need no interface (n = 1, nothing opaque): the volume has no interfaces field and
+// no table, which readers would refuse as "0 slots" (voxelize wrote such a volume that lightsim and
+// the viewer could not open).
+TEST(SharpInterfaces, ObjectsOfAirMakeAVolumeWithoutInterfaces) {
+  const GridSpec g = cube(16, 0.6);
+  const Volume v = buildSharpVolume(regionsOf({"procedural:box,size=0.5:0.5:0.5,ior=1.0"}, g), g, interfaceBand(g));
+  EXPECT_FALSE(v.has("interfaces"));
+  EXPECT_FALSE(v.metadata.contains("interfaces"));
+  EXPECT_TRUE(interfaceTable(v).empty());  // the reader's view: a volume without sharp interfaces
+  for (float n : v.fields.at("ior").data) ASSERT_EQ(n, 1.0f);
 }
 
 TEST(SharpInterfaces, AGradedLensKeepsItsOwnNAndGradientAcrossTheSurface) {
