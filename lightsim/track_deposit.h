@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <cstddef>
 
 #include <glm/glm.hpp>
@@ -51,57 +52,72 @@ inline HatWeights hatWeights(const glm::dvec3& p, const glm::ivec3& dims) {
 }
 
 namespace detail {
-// forEachTrackWeight on a segment that crosses at most kMaxBreaks planes through voxel centres;
-// every weight is multiplied by `scale`.
+// forEachTrackWeight on a segment of a few dozen voxels at most, every weight multiplied by
+// `scale`: a walk through the cells of the voxel-centre lattice (cells between planes through voxel
+// centres, where the hats have their kinks), one piece per cell, each integrated with 2-point
+// Gauss–Legendre (exact: the weights are cubic in the arc length there).
 template <typename Visit>
 void trackWeightsShort(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec3& dims, double scale, Visit&& visit) {
-  // Parameters in (0, 1) where the segment crosses a plane through voxel centres: at most
-  // 3 + Σ|b − a| of them.
-  constexpr int kMaxBreaks = 64;
-  std::array<double, kMaxBreaks + 2> breaks;
-  int count = 0;
-  breaks[count++] = 0.0;
+  const glm::dvec3 c0 = a - 0.5;  // lattice coordinates: cell k spans [k, k + 1)
   const glm::dvec3 delta = b - a;
+  glm::ivec3 cell, step;
+  glm::dvec3 next, every;  // parameter of the next plane crossing along each axis, and between planes
   for (int axis = 0; axis < 3; ++axis) {
-    if (delta[axis] == 0.0) continue;
-    const double s0 = a[axis] - 0.5, s1 = b[axis] - 0.5;
-    const double lo = std::min(s0, s1), hi = std::max(s0, s1);
-    for (double k = std::floor(lo) + 1.0; k < hi && count <= kMaxBreaks; k += 1.0)
-      breaks[static_cast<std::size_t>(count++)] = (k - s0) / (s1 - s0);
-  }
-  breaks[static_cast<std::size_t>(count++)] = 1.0;
-  // Insertion sort: a step crosses few planes.
-  for (int i = 2; i < count - 1; ++i) {
-    const double v = breaks[static_cast<std::size_t>(i)];
-    int j = i - 1;
-    while (j >= 1 && breaks[static_cast<std::size_t>(j)] > v) {
-      breaks[static_cast<std::size_t>(j + 1)] = breaks[static_cast<std::size_t>(j)];
-      --j;
+    const double f = std::floor(c0[axis]);
+    cell[axis] = static_cast<int>(f);
+    if (delta[axis] > 0.0) {
+      step[axis] = 1;
+      every[axis] = 1.0 / delta[axis];
+      next[axis] = (f + 1.0 - c0[axis]) * every[axis];
+    } else if (delta[axis] < 0.0) {
+      step[axis] = -1;
+      every[axis] = -1.0 / delta[axis];
+      // Starting on a plane and moving down: the cell below it.
+      if (f == c0[axis]) cell[axis] -= 1;
+      next[axis] = (c0[axis] - static_cast<double>(cell[axis])) * every[axis];
+    } else {
+      step[axis] = 0;
+      every[axis] = 0.0;
+      next[axis] = std::numeric_limits<double>::infinity();
     }
-    breaks[static_cast<std::size_t>(j + 1)] = v;
   }
+  const long long sx = 1, sy = dims.x, sz = static_cast<long long>(dims.x) * dims.y;
   constexpr double kGauss = 0.28867513459481288225;  // 1/(2√3): the 2-point nodes at ½ ± this
-  for (int piece = 0; piece + 1 < count; ++piece) {
-    const double t0 = breaks[static_cast<std::size_t>(piece)], t1 = breaks[static_cast<std::size_t>(piece + 1)];
+  double t0 = 0.0;
+  while (t0 < 1.0) {
+    int axis = next.x <= next.y ? (next.x <= next.z ? 0 : 2) : (next.y <= next.z ? 1 : 2);
+    const double t1 = std::min(1.0, next[axis]);
     const double length = t1 - t0;
-    if (!(length > 0.0)) continue;
-    // A piece lies in one cell of the voxel-centre lattice, so both nodes share its eight hats:
-    // their weights are summed first and each hat visited once.
-    const glm::dvec3 base = glm::floor(a + (t0 + 0.5 * length) * delta - 0.5);
-    std::array<double, 8> weight{};
-    for (const double node : {0.5 - kGauss, 0.5 + kGauss}) {
-      const glm::dvec3 t = glm::clamp(a + (t0 + node * length) * delta - 0.5 - base, 0.0, 1.0);
-      for (int k = 0; k < 8; ++k)
-        weight[static_cast<std::size_t>(k)] += ((k & 1) ? t.x : 1.0 - t.x) * ((k & 2) ? t.y : 1.0 - t.y) * ((k & 4) ? t.z : 1.0 - t.z);
+    if (length > 0.0) {
+      // Both nodes lie in this cell and share its eight hats: their weights are summed first.
+      std::array<double, 8> weight;
+      const glm::dvec3 base(cell);
+      const glm::dvec3 p = glm::clamp(c0 + (t0 + (0.5 - kGauss) * length) * delta - base, 0.0, 1.0);
+      const glm::dvec3 q = glm::clamp(c0 + (t0 + (0.5 + kGauss) * length) * delta - base, 0.0, 1.0);
+      for (int k = 0; k < 8; ++k) {
+        const double wp = ((k & 1) ? p.x : 1.0 - p.x) * ((k & 2) ? p.y : 1.0 - p.y) * ((k & 4) ? p.z : 1.0 - p.z);
+        const double wq = ((k & 1) ? q.x : 1.0 - q.x) * ((k & 2) ? q.y : 1.0 - q.y) * ((k & 4) ? q.z : 1.0 - q.z);
+        weight[static_cast<std::size_t>(k)] = wp + wq;
+      }
+      const double piece = scale * 0.5 * length;
+      const bool interior = cell.x >= 0 && cell.y >= 0 && cell.z >= 0 && cell.x + 1 < dims.x && cell.y + 1 < dims.y &&
+                            cell.z + 1 < dims.z;
+      const long long origin = cell.x * sx + cell.y * sy + cell.z * sz;
+      for (int k = 0; k < 8; ++k) {
+        const double w = weight[static_cast<std::size_t>(k)];
+        if (w == 0.0) continue;
+        const int dx = k & 1, dy = (k >> 1) & 1, dz = (k >> 2) & 1;
+        if (!interior) {
+          const int x = cell.x + dx, y = cell.y + dy, z = cell.z + dz;
+          if (x < 0 || y < 0 || z < 0 || x >= dims.x || y >= dims.y || z >= dims.z) continue;
+        }
+        visit(origin + dx * sx + dy * sy + dz * sz, piece * w);
+      }
     }
-    const glm::ivec3 i0(base);
-    for (int k = 0; k < 8; ++k) {
-      const glm::ivec3 v = i0 + glm::ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
-      const double w = weight[static_cast<std::size_t>(k)];
-      if (w == 0.0 || v.x < 0 || v.y < 0 || v.z < 0 || v.x >= dims.x || v.y >= dims.y || v.z >= dims.z) continue;
-      visit(static_cast<long long>(v.x) + static_cast<long long>(dims.x) * (static_cast<long long>(v.y) + static_cast<long long>(dims.y) * v.z),
-            scale * (0.5 * length * w));
-    }
+    if (t1 >= 1.0) break;
+    t0 = t1;
+    cell[axis] += step[axis];
+    next[axis] += every[axis];
   }
 }
 }  // namespace detail
@@ -117,6 +133,7 @@ void forEachTrackWeight(const glm::dvec3& a, const glm::dvec3& b, const glm::ive
   // visits nothing. A segment that leaves it (a flight out of the grid) is cut, its weights scaled
   // by the share of the length kept.
   const glm::dvec3 delta = b - a;
+  if (!std::isfinite(delta.x + delta.y + delta.z + a.x + a.y + a.z)) return;  // nothing to integrate
   double f0 = 0.0, f1 = 1.0;
   for (int axis = 0; axis < 3; ++axis) {
     const double lo = -0.5, hi = dims[axis] + 0.5;
