@@ -3,14 +3,18 @@
 #include <unistd.h>
 
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <string_view>
 
 #include "core/error.h"
 
 namespace eik {
+
+bool finiteAsFloat(double v) { return std::isfinite(v) && std::fabs(v) <= static_cast<double>(std::numeric_limits<float>::max()); }
 namespace {
 
 // Parses a whole string as an unsigned decimal; false for anything else.

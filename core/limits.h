@@ -12,6 +12,15 @@ namespace eik {
 // Largest grid size per axis any reader accepts (issue "Foundation": volumes up to 1024³).
 constexpr int kMaxVolumeAxis = 1024;
 
+// The largest light power (W/m² of a directional light, W/sr of a point light) a bake accepts: its
+// results are stored as 32-bit floats, and a caustic concentrates the light by orders of magnitude,
+// so a light near the float limit overflows only after the whole bake (docs/programs.md).
+constexpr double kMaxLightPower = 1e30;
+
+// Is v representable as a finite 32-bit float (|v| ≤ FLT_MAX)? A number finite as a double but not
+// as a float (1e39) would become +Inf in a field or a shader.
+bool finiteAsFloat(double v);
+
 // Memory this process may use: physical memory from sysconf, lowered to a cgroup v2 limit when
 // one is set. The environment variable EIKONAL_MEMORY_LIMIT_BYTES overrides both (for tests).
 std::uint64_t physicalMemoryBytes();

@@ -4,6 +4,7 @@
 #include <set>
 
 #include "core/error.h"
+#include "core/volume.h"
 
 namespace eik {
 
@@ -77,6 +78,8 @@ ReceiverMap receiverFromJson(const nlohmann::json& j, const std::string& source,
   if (j.contains("name")) {
     if (!j.at("name").is_string()) throw InputError(source, key + ".name", "expected a string");
     map.name = j.at("name").get<std::string>();
+    if (!isValidFieldName(map.name))
+      throw InputError(source, key + ".name", "a receiver name may hold only letters, digits, '_' and '-'");
   }
   if (!j.at("file").is_string() || j.at("file").get<std::string>().empty())
     throw InputError(source, key + ".file", "expected a file name");

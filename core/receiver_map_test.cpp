@@ -83,6 +83,9 @@ TEST(ReceiverMap, MalformedEntriesNameTheKey) {
   bad = good;
   bad.erase("origin");
   EXPECT_CONTAINS(inputErrorOf([&] { receiverFromJson(bad, "v.json", "receivers[0]", file); }), "receivers[0].origin: missing");
+  bad = good;
+  bad["name"] = "../ground";  // becomes part of a file name when the volume is written again
+  EXPECT_CONTAINS(inputErrorOf([&] { receiverFromJson(bad, "v.json", "receivers[0]", file); }), "receivers[0].name: a receiver name");
 }
 
 }  // namespace

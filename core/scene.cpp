@@ -1,5 +1,7 @@
 #include "core/scene.h"
 
+#include "core/limits.h"
+
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -46,6 +48,7 @@ class ObjectReader {
     if (!v.is_number()) fail(child(key), "expected a number, got " + std::string(v.type_name()));
     double d = v.get<double>();
     if (!std::isfinite(d)) fail(child(key), "not a finite number");
+    if (!finiteAsFloat(d)) fail(child(key), "beyond the range of a 32-bit float");
     return d;
   }
 
@@ -65,6 +68,7 @@ class ObjectReader {
       if (!v[static_cast<std::size_t>(i)].is_number()) fail(child(key), "expected an array of 3 numbers");
       out[i] = v[static_cast<std::size_t>(i)].get<double>();
       if (!std::isfinite(out[i])) fail(child(key), "not a finite number");
+      if (!finiteAsFloat(out[i])) fail(child(key), "beyond the range of a 32-bit float");
     }
     return out;
   }
@@ -99,6 +103,11 @@ glm::dvec3 requireUnit(const ObjectReader& r, const char* key, const glm::dvec3&
 
 void requireNonNegative(const ObjectReader& r, const char* key, const glm::dvec3& v) {
   if (v.x < 0 || v.y < 0 || v.z < 0) r.fail(r.child(key), "must not be negative");
+}
+
+void requireLightPower(const ObjectReader& r, const char* key, const glm::dvec3& v) {
+  if (std::max(v.x, std::max(v.y, v.z)) > kMaxLightPower)
+    r.fail(r.child(key), "must be at most 1e30 (bakes store 32-bit floats, which a caustic would overflow)");
 }
 
 }  // namespace
@@ -152,6 +161,7 @@ Scene sceneFromJson(const json& j, const std::string& source) {
         light.direction = requireUnit(r, "direction", r.vec3("direction", light.direction));
         light.irradiance = r.vec3("irradiance", light.irradiance);
         requireNonNegative(r, "irradiance", light.irradiance);
+        requireLightPower(r, "irradiance", light.irradiance);
         if (r.has("position") || r.has("intensity")) r.fail(path, "a directional light takes direction and irradiance");
       } else if (type == "point") {
         light.type = SceneLightSpec::Type::Point;
@@ -159,6 +169,7 @@ Scene sceneFromJson(const json& j, const std::string& source) {
         light.position = r.vec3("position", light.position);
         light.intensity = r.vec3("intensity", light.intensity);
         requireNonNegative(r, "intensity", light.intensity);
+        requireLightPower(r, "intensity", light.intensity);
         if (r.has("direction") || r.has("irradiance")) r.fail(path, "a point light takes position and intensity");
       } else {
         r.fail(path + ".type", "expected \"directional\" or \"point\", got \"" + type + "\"");

@@ -71,6 +71,17 @@ TEST(Scene, RejectsWrongTypes) {
   EXPECT_NE(errorOf(R"({"lights": [{"type": "directional", "direction": [0,0,0]}]})").find("zero vector"),
             std::string::npos);
   EXPECT_NE(errorOf(R"([1, 2])").find("expected an object"), std::string::npos);
+  // Finite as doubles but not as floats (the viewer's uniforms, the bake's fields): refused where
+  // read, naming the key; a light's power up to 1e30 (kMaxLightPower).
+  EXPECT_NE(errorOf(R"({"camera": {"eye": [0, 0, 1e39]}})").find("camera.eye: beyond the range of a 32-bit float"),
+            std::string::npos);
+  EXPECT_NE(errorOf(R"({"lights": [{"type": "directional", "direction": [0,-1,0], "irradiance": [1e300, 1, 1]}]})")
+                .find("lights[0].irradiance"),
+            std::string::npos);
+  EXPECT_NE(errorOf(R"({"lights": [{"type": "point", "position": [0,1,0], "intensity": [1, 1e31, 1]}]})")
+                .find("lights[0].intensity: must be at most 1e30"),
+            std::string::npos);
+  EXPECT_EQ(errorOf(R"({"lights": [{"type": "point", "position": [0,1,0], "intensity": [1, 1e30, 1]}]})"), "");
 }
 
 TEST(Scene, EnvironmentKindsAreExclusive) {

@@ -56,13 +56,6 @@ std::string manifestStem(const fs::path& manifest) {
   return name;
 }
 
-bool isValidFieldName(const std::string& name) {
-  if (name.empty()) return false;
-  for (char c : name) {
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) return false;
-  }
-  return true;
-}
 
 NrrdHeader nrrdHeaderFor(const GridSpec& grid, int components) {
   NrrdHeader header;
@@ -110,6 +103,10 @@ class ManifestReader {
     std::vector<Entry> entries;
     std::uint64_t total_bytes = 0;
     for (const auto& [name, spec] : fields->items()) {
+      // The writer's rule, checked when reading: a name that cannot be written back (a path such
+      // as "../evil") is refused before anything is baked from it.
+      if (!isValidFieldName(name))
+        throw InputError(name_, "fields." + name, "a field name may hold only letters, digits, '_' and '-'");
       Entry entry{name, fieldFile(name, spec), {}};
       entry.header = fieldHeader(name, spec, entry.file, volume.grid);
       total_bytes += fieldBytes(entry.header.sizes, entry.header.components);
@@ -337,6 +334,14 @@ class ManifestReader {
 };
 
 }  // namespace
+
+bool isValidFieldName(const std::string& name) {
+  if (name.empty()) return false;
+  for (char c : name) {
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) return false;
+  }
+  return true;
+}
 
 // ---------------------------------------------------------------------------------------------
 

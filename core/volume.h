@@ -63,6 +63,10 @@ struct VolumeWriteOptions {
 // Reads a manifest and every field it names. Throws InputError (exit 2) naming the file and the
 // field for anything malformed (docs/volume-format.md, issue "Foundation" §3).
 Volume readVolume(const std::filesystem::path& manifest);
+
+// A field or receiver name the format allows: letters, digits, '_' and '-' (it becomes part of a
+// file name). Readers refuse other names, the writer never writes them.
+bool isValidFieldName(const std::string& name);
 // Reads only the manifest and the headers (grid, field table); no voxel data.
 Volume readVolumeHeader(const std::filesystem::path& manifest);
 

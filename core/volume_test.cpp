@@ -202,6 +202,22 @@ TEST(VolumeMalformed, MissingFieldFile) {
   EXPECT_THROW(readVolumeHeader(dir / "scene.vol.json"), InputError);
 }
 
+// A field name the writer would refuse (it becomes part of a file name) is refused when read, before
+// a program works on the volume: `../evil` was read, baked, then refused at write time.
+TEST(VolumeMalformed, FieldNamesThatAreNotNamesAreRefusedOnRead) {
+  TempDir dir;
+  json manifest = writeSample(dir);
+  for (const char* bad : {"../evil", "a/b", "", "x.y"}) {
+    json m = manifest;
+    m["fields"][bad] = m["fields"]["ior"];
+    rewriteManifest(dir, m);
+    EXPECT_CONTAINS(manifestError(dir), (dir / "scene.vol.json").string() + ": fields." + bad + ": a field name may hold only");
+  }
+  EXPECT_TRUE(isValidFieldName("ior_grad"));
+  EXPECT_TRUE(isValidFieldName("Sigma-2"));
+  EXPECT_FALSE(isValidFieldName(".."));
+}
+
 TEST(VolumeMalformed, MissingDims) {
   TempDir dir;
   json manifest = writeSample(dir);

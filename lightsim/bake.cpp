@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "core/gaussian_filter.h"
 #include "core/scene.h"
 
@@ -133,6 +134,8 @@ LightSpec parseLight(const std::string& light_text, const std::string& power_tex
   light.power = p.size() == 1 ? glm::dvec3(p[0]) : glm::dvec3(p[0], p[1], p[2]);
   if (light.power.x < 0.0 || light.power.y < 0.0 || light.power.z < 0.0)
     throw InputError("--power", "", "'" + power_text + "': must not be negative");
+  if (std::max(light.power.x, std::max(light.power.y, light.power.z)) > kMaxLightPower)
+    throw InputError("--power", "", "'" + power_text + "': must be at most 1e30 (bakes store 32-bit floats, which a caustic would overflow)");
   if (light.power.x == 0.0 && light.power.y == 0.0 && light.power.z == 0.0)
     throw InputError("--power", "", "'" + power_text + "': must not be zero in every channel");
   return light;

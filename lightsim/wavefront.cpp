@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "core/parallel.h"
 
 namespace eik {
@@ -462,6 +463,8 @@ void validateLight(const LightSpec& light) {
   if (!finite3(light.power)) throw InputError("light", "power", "must be finite");
   if (light.power.x < 0.0 || light.power.y < 0.0 || light.power.z < 0.0)
     throw InputError("light", "power", "must not be negative");
+  if (std::max(light.power.x, std::max(light.power.y, light.power.z)) > kMaxLightPower)
+    throw InputError("light", "power", "must be at most 1e30 (bakes store 32-bit floats)");
   if (light.type == LightSpec::Type::Directional) {
     if (!finite3(light.direction) || glm::length(light.direction) == 0.0)
       throw InputError("light", "direction", "must be a finite, non-zero vector");

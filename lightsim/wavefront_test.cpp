@@ -535,9 +535,15 @@ TEST(ParseLight, Errors) {
                           "point:a,b,c", "point:1,,2", "point:1,2,nan", "point:1,2,inf", "directional:1e999,0,0", ""}) {
     EXPECT_THROW(parseLight(bad, "1,1,1"), InputError) << bad;
   }
-  for (const char* bad : {"0,0,0", "0", "-1,1,1", "1,2", "x", "1,1,1,1", ""}) {
+  // 1e300 and 1e31: finite as doubles, but a bake of them overflows its 32-bit float fields (it
+  // failed when writing, after the whole bake); the limit is kMaxLightPower = 1e30.
+  for (const char* bad : {"0,0,0", "0", "-1,1,1", "1,2", "x", "1,1,1,1", "", "1e300", "1,1e31,1"}) {
     EXPECT_THROW(parseLight("directional:0,-1,0", bad), InputError) << bad;
   }
+  EXPECT_EQ(parseLight("directional:0,-1,0", "1e30").power, glm::dvec3(1e30));
+  LightSpec strong;
+  strong.power = glm::dvec3(1e31);
+  EXPECT_THROW(validateLight(strong), InputError);
   try {
     parseLight("directional:0,0,0", "1");
     FAIL();

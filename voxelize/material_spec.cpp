@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "core/text.h"
 
 namespace eik {
@@ -57,6 +58,8 @@ double parseNumber(const std::string& text, const std::string& source, const std
   const auto [ptr, ec] = std::from_chars(first, last, value);
   if (t.empty() || ec != std::errc() || ptr != last || !std::isfinite(value))
     throw InputError(source, key, "'" + text + "' is not a number");
+  if (!finiteAsFloat(value))
+    throw InputError(source, key, "'" + text + "' is beyond the range of a 32-bit float (the fields store floats)");
   return value;
 }
 

@@ -28,6 +28,16 @@ TEST(MaterialSpec, ParsesEveryKey) {
   EXPECT_NEAR(m.dispersion_b, 0.523655 * 0.7 / 40.0, 1e-6);
 }
 
+// 1e39 is a finite double but +Inf as the float every field stores: refused where it is read
+// (it failed when writing the NRRD, after the whole voxelization).
+TEST(MaterialSpec, ValuesBeyondFloatAreRefused) {
+  for (const char* bad : {"ior=1e39", "sigma_a=1:1e39:1", "emission=-1e40"}) {
+    const std::string e = inputErrorOf([&] { parseMaterialSpec(bad, Material{}); });
+    EXPECT_NE(e.find("32-bit float"), std::string::npos) << bad << ": " << e;
+  }
+  EXPECT_EQ(parseMaterialSpec("sigma_a=3e38", Material{}).sigma_a.x, 3e38f);
+}
+
 TEST(MaterialSpec, KeepsTheBaseForKeysNotGiven) {
   Material base;
   base.ior = 1.33f;
