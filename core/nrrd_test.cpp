@@ -76,7 +76,9 @@ NrrdImage randomImage(int components, glm::ivec3 sizes) {
   image.data.resize(image.voxelCount() * static_cast<std::size_t>(components));
   for (float& v : image.data) v = normal(random);
   image.data[0] = -0.0f;
-  image.data[1 % image.data.size()] = std::numeric_limits<float>::denorm_min();
+  // The smallest normal float: subnormals are written as 0 (and refused when read: the sign of a
+  // wrong byte order), everything else round-trips bit for bit.
+  image.data[1 % image.data.size()] = std::numeric_limits<float>::min();
   image.data[2 % image.data.size()] = std::numeric_limits<float>::max();
   return image;
 }
@@ -268,6 +270,28 @@ TEST(NrrdMalformed, WrongMagic) {
   expectRejected(dir / "b.nrrd", "magic", "not a NRRD file");
   writeFile(dir / "c.nrrd", "");
   expectRejected(dir / "c.nrrd", "magic", "empty");
+}
+
+// A field of n = 1 whose header says big-endian though the bytes are little-endian reads as
+// 4.6·10⁻⁴¹ (it was accepted): subnormal values are refused, the message pointing at the
+// endianness. Zero reads as zero either way, so the first non-zero voxel is named.
+TEST(NrrdMalformed, MislabelledEndiannessIsRefused) {
+  TempDir dir;
+  std::vector<float> values(24, 1.0f);
+  values[0] = 0.0f;
+  writeFile(dir / "swapped.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 3 4\nendian: big\nencoding: raw\n\n" +
+                                      floatBytes(values));
+  expectRejected(dir / "swapped.nrrd", "data", "subnormal value 4.6e-41 at voxel (1, 0, 0)");
+  EXPECT_CONTAINS(inputErrorOf([&] { readNrrd(dir / "swapped.nrrd"); }), "endian");
+  // The writer never writes one: below FLT_MIN becomes 0, and the file reads back.
+  NrrdImage image = randomImage(1, {2, 3, 4});
+  image.data[5] = 1e-40f;
+  image.data[6] = -3e-39f;
+  writeNrrd(dir / "tiny.nrrd", image, {});
+  const NrrdImage back = readNrrd(dir / "tiny.nrrd");
+  EXPECT_EQ(back.data[5], 0.0f);
+  EXPECT_EQ(back.data[6], 0.0f);
+  EXPECT_EQ(back.data[7], image.data[7]);
 }
 
 TEST(NrrdMalformed, TruncatedRawData) {
