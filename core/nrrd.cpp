@@ -116,6 +116,33 @@ void checkRawLength(std::FILE* file, const fs::path& path, const ParsedHeader& p
   if (available > expected) fail(path, "data", tooMuchMessage(parsed, expected, available - expected, false));
 }
 
+// For gzip and ASCII data the file length bounds what the data can hold, before anything is
+// allocated: deflate expands at most 1032:1, and an ASCII value takes at least two characters
+// (a digit and a separator). A header that declares more (a 250-byte file claiming 1024³ values)
+// is refused at once instead of allocating and zero-filling gigabytes first.
+void checkEncodedLength(std::FILE* file, const fs::path& path, const ParsedHeader& parsed) {
+  off_t here = ftello(file);
+  if (here < 0 || fseeko(file, 0, SEEK_END) != 0) return;  // not seekable: the readers check as they read
+  off_t end = ftello(file);
+  fseeko(file, here, SEEK_SET);
+  const std::uint64_t available =
+      end - here > parsed.byte_skip ? static_cast<std::uint64_t>(end - here - parsed.byte_skip) : 0;
+  const std::uint64_t values = parsed.header.valueCount();
+  if (parsed.encoding == Encoding::Gzip) {
+    constexpr std::uint64_t kMaxDeflateRatio = 1032;
+    const std::uint64_t expected = values * sizeof(float);
+    if (expected / kMaxDeflateRatio > available + 64)
+      fail(path, "data", dataSource(parsed) + "truncated: sizes need " + std::to_string(expected) +
+                             " bytes of float32 data; a gzip stream of " + std::to_string(available) +
+                             " bytes holds at most " + std::to_string(available * kMaxDeflateRatio));
+  } else if (parsed.encoding == Encoding::Ascii) {
+    if (values > available / 2 + 1)
+      fail(path, "data", dataSource(parsed) + "truncated: sizes call for " + std::to_string(values) + " values, " +
+                             std::to_string(available) + " bytes of text hold at most " +
+                             std::to_string(available / 2 + 1));
+  }
+}
+
 // A gzip data section (core/gzip_stream.h), with the messages of the other encodings.
 void readGzip(std::FILE* file, std::span<std::byte> out, const fs::path& path, const ParsedHeader& parsed) {
   const GzipReadResult read = readGzipStream(file, out, static_cast<std::uint64_t>(parsed.byte_skip));
@@ -348,6 +375,7 @@ NrrdImage readNrrd(const fs::path& path) {
   skipLines(file, parsed.line_skip, path, parsed);
 
   if (parsed.encoding == Encoding::Raw) checkRawLength(file, path, parsed);  // before allocating
+  else checkEncodedLength(file, path, parsed);
 
   NrrdImage image;
   image.components = parsed.header.components;

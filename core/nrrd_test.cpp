@@ -294,6 +294,22 @@ TEST(NrrdMalformed, MislabelledEndiannessIsRefused) {
   EXPECT_EQ(back.data[7], image.data[7]);
 }
 
+// A tiny gzip or ASCII file whose header declares a huge grid is refused before the data is
+// allocated (a 250-byte gzip NRRD declaring 1024³·3 values took 12 GiB and seconds of zero-filling):
+// deflate expands at most 1032:1, an ASCII value takes two characters.
+TEST(NrrdMalformed, HugeSizesInATinyEncodedFileAreRefusedBeforeAllocating) {
+  TempDir dir;
+  writeFile(dir / "bomb.nrrd", "NRRD0004\ntype: float\ndimension: 4\nsizes: 3 1024 1024 1024\nendian: little\n"
+                               "encoding: gzip\n\n" + gzipBytes(floatBytes(ramp(24))));
+  expectRejected(dir / "bomb.nrrd", "data", "bytes holds at most");
+  writeFile(dir / "text.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 1024 1024 1024\nencoding: ascii\n\n1 2 3 4\n");
+  expectRejected(dir / "text.nrrd", "data", "bytes of text hold at most");
+  // What fits is still read (and a short stream still reported as truncated by the reader).
+  writeFile(dir / "fits.nrrd", "NRRD0004\n" + std::string("type: float\ndimension: 3\nsizes: 2 3 4\nencoding: ascii\n\n") +
+                                   "0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23\n");
+  EXPECT_EQ(readNrrd(dir / "fits.nrrd").data.size(), 24u);
+}
+
 TEST(NrrdMalformed, TruncatedRawData) {
   TempDir dir;
   writeFile(dir / "t.nrrd", "NRRD0004\n" + kScalarHeader + "\n" + floatBytes(ramp(23)));
