@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <cstring>
 
+#include "core/limits.h"
+
 namespace eik {
 namespace {
 
@@ -82,16 +84,13 @@ std::vector<T> GltfAccessors::read(int index, std::initializer_list<int> types, 
   if (count > kMaxElements) diag_.fail(field + ".count", str(count) + " elements is more than this program reads");
   if (components_out) *components_out = components;
 
-  std::vector<T> values(count * static_cast<std::size_t>(components), T(0));
-  auto read = [&](const unsigned char* element, std::size_t i) {
-    for (int c = 0; c < components; ++c)
-      values[i * static_cast<std::size_t>(components) + static_cast<std::size_t>(c)] =
-          static_cast<T>(readComponent(element + static_cast<std::size_t>(c * csize), acc.componentType, acc.normalized));
-  };
-
+  // Checked before the values are allocated (a count of 3·10⁸ on a tiny buffer allocated 7 GB before
+  // the bounds check refused it): a count backed by a buffer view must fit it; a sparse accessor
+  // without one is zeros plus its sparse values, so it must fit in memory.
+  const unsigned char* view_data = nullptr;
+  std::size_t view_stride = element_size;
   if (acc.bufferView >= 0) {
-    const std::size_t stride_default = element_size;
-    const auto [data, view_length, stride] = bufferView(acc.bufferView, field + ".bufferView", stride_default);
+    const auto [data, view_length, stride] = bufferView(acc.bufferView, field + ".bufferView", element_size);
     if (stride < element_size)
       diag_.fail(indexed("bufferViews", static_cast<std::size_t>(acc.bufferView)) + ".byteStride",
                  str(stride) + " is smaller than the " + str(element_size) + "-byte elements of " + field);
@@ -102,11 +101,23 @@ std::vector<T> GltfAccessors::read(int index, std::initializer_list<int> types, 
         diag_.fail(field, "reads past the end of bufferViews[" + str(acc.bufferView) + "]: " + str(count) +
                               " elements from byteOffset " + str(acc.byteOffset) + " need " +
                               str(static_cast<std::size_t>(need)) + " bytes, the view has " + str(view_length));
-      for (std::size_t i = 0; i < count; ++i) read(data + acc.byteOffset + i * stride, i);
     }
+    view_data = data;
+    view_stride = stride;
   } else if (!acc.sparse.isSparse && count > 0) {
     diag_.fail(field + ".bufferView", "missing (and the accessor is not sparse)");
+  } else if (static_cast<std::uint64_t>(count) * components * sizeof(T) > physicalMemoryBytes()) {
+    diag_.fail(field + ".count", str(count) + " elements need more memory than this machine has");
   }
+  std::vector<T> values(count * static_cast<std::size_t>(components), T(0));
+  auto read = [&](const unsigned char* element, std::size_t i) {
+    for (int c = 0; c < components; ++c)
+      values[i * static_cast<std::size_t>(components) + static_cast<std::size_t>(c)] =
+          static_cast<T>(readComponent(element + static_cast<std::size_t>(c * csize), acc.componentType, acc.normalized));
+  };
+
+  if (view_data)
+    for (std::size_t i = 0; i < count; ++i) read(view_data + acc.byteOffset + i * view_stride, i);
 
   if (acc.sparse.isSparse) {
     const std::string sfield = field + ".sparse";

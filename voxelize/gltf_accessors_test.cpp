@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -110,6 +112,32 @@ TEST(GltfAccessors, RefusesEveryReadItCannotCheck) {
   EXPECT_EQ(errorOf(2), "m.gltf: accessors[2].componentType: SHORT cannot be used as POSITION");
   EXPECT_EQ(errorOf(3), "m.gltf: accessors[3].bufferView: buffer view 5 out of range (the file has 1 buffer views)");
   EXPECT_EQ(errorOf(4), "m.gltf: POSITION: accessor 4 out of range (the file has 4 accessors)");
+}
+
+// A huge count on a tiny buffer is refused by the bounds check before any value is allocated: 2·10⁹
+// VEC3 elements as doubles would be 48 GB (the check used to come after the allocation, which
+// failed with a bare "out of memory" or took 7 GB for a count of 3·10⁸). A sparse accessor without
+// a buffer view that would need more memory than the machine has is refused alike.
+TEST(GltfAccessors, HugeCountsAreRefusedBeforeAllocating) {
+  tinygltf::Model model = modelWith(bytesOf(std::vector<float>{1, 2, 3, 4, 5, 6}));
+  model.accessors.push_back(accessor(TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, 2'000'000'000));
+  tinygltf::Accessor sparse = accessor(TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, 2'000'000'000);
+  sparse.bufferView = -1;
+  sparse.sparse.isSparse = true;
+  sparse.sparse.count = 0;
+  model.accessors.push_back(sparse);
+  std::vector<std::string> warnings;
+  const GltfAccessors accessors(model, {"m.gltf", &warnings});
+  auto errorOf = [&](int index) {
+    return inputErrorOf([&] {
+      accessors.read<double>(index, {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT}, "POSITION");
+    });
+  };
+  EXPECT_NE(errorOf(0).find("m.gltf: accessors[0]: reads past the end of bufferViews[0]: 2000000000 elements"),
+            std::string::npos);
+  ::setenv("EIKONAL_MEMORY_LIMIT_BYTES", "1000000000", 1);  // 1 GB, whatever this machine has
+  EXPECT_EQ(errorOf(1), "m.gltf: accessors[1].count: 2000000000 elements need more memory than this machine has");
+  ::unsetenv("EIKONAL_MEMORY_LIMIT_BYTES");
 }
 
 }  // namespace
