@@ -175,12 +175,12 @@ TEST(ExactOpticsSphere, FreeFlightBakesTheSameCausticInFewerSteps) {
   const SphereBake stepped = bakeSphereOnFloor(32, false), flown = bakeSphereOnFloor(32, true);
   EXPECT_EQ(stepped.stats.flights, 0u);
   EXPECT_GT(flown.stats.flights, 0u);
-  // Measured 2.0× fewer patch-steps at 32³ and 3.7× at 64³ (the air above and beside the sphere,
-  // the glass inside it, the way down to the floor; at 32³ the band of noisy bricks around the
+  // Measured 3.5× fewer patch-steps at 32³ and 6.1× at 64³ (the air above and beside the sphere,
+  // the glass inside it, the way down to the floor; at 32³ the band of noisy voxels around the
   // surface is a larger part of the sphere).
   EXPECT_LT(flown.stats.total_patches, stepped.stats.total_patches / 3 * 2);
   // What changes: where a step ends, so where the patches split and meet the sphere. Measured
-  // relative L2 5.6e-6 (map) and 3.0e-3 (field); 1 % would be a visible change of the caustic.
+  // relative L2 4.0e-5 (map) and 3.8e-3 (field); 1 % would be a visible change of the caustic.
   const double map = relativeL2(flown.map.irradiance, stepped.map.irradiance);
   const double field = relativeL2(flown.irradiance.data, stepped.irradiance.data);
   std::printf("free flight against steps of Δt, 32³: map %.2e, field %.2e relative L2; %llu against %llu patch-steps\n", map,

@@ -26,7 +26,8 @@ QuietMap::QuietMap(const GridSpec& grid, const std::vector<glm::vec4>& ior_grad,
     : grid_(grid) {
   const glm::ivec3 d = grid.dims;
   if (d.x <= 0 || d.y <= 0 || d.z <= 0 || ior_grad.size() != grid.count()) return;
-  brick_ = std::max(d.x, std::max(d.y, d.z)) > 512 ? 4 : 2;
+  const int longest = std::max(d.x, std::max(d.y, d.z));
+  brick_ = longest <= 160 ? 1 : longest <= 512 ? 2 : 4;
   bricks_ = (d + (brick_ - 1)) / brick_;
   const bool sharp = !table.empty() && distances.size() == grid.count();
   const int slots = sharp ? static_cast<int>(table.slots.size()) : 0;
