@@ -189,8 +189,6 @@ bool willTear(const Patch& patch, const SharpUpdate& u, const VolumeSampler& sam
 // quiet. Its length: doubled from 2Δt while the box stays quiet, then refined by bisection, and
 // bounded so that no edge grows past the split length (or past its length now, if longer) and by
 // ctx.flight_cap.
-bool options_keep(const StepContext& ctx) { return ctx.options->at_max_depth == DepthLimit::Keep; }
-
 double freeFlightTime(const Patch& patch, const PatchSamples& samples, const StepContext& ctx, double threshold) {
   if (ctx.sampler->sharp()) {
     if (!oneMedium(patch) || patch.crossed != 0 || patch.reflect_pending != 0.0) return 0.0;
@@ -205,7 +203,7 @@ double freeFlightTime(const Patch& patch, const PatchSamples& samples, const Ste
   }
   // The longest an edge may grow to: the split length, or its length now if longer; at the depth
   // limit, a kept patch as far as it would go on unsplit (stepPatch's analysis).
-  const bool kept = options_keep(ctx) && patch.depth >= ctx.options->max_depth;
+  const bool kept = ctx.options->at_max_depth == DepthLimit::Keep && patch.depth >= ctx.options->max_depth;
   double t_max = std::numeric_limits<double>::infinity();
   for (int c = 0; c < 4; ++c) {
     // A path of length ℓ takes time ℓ·n (|dx/dt| = 1/n).
@@ -498,7 +496,8 @@ struct DepositSum {
 // voxel belongs to one slab, whose thread adds the sub-paths in patch order, so the sums do not
 // depend on the thread count.
 void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<PatchStepResult>& results,
-                        const GridSpec& grid, const ReceiverMap* receiver, std::vector<DepositSum>& sums, std::vector<std::vector<std::uint32_t>>& by_slab) {
+                        const GridSpec& grid, const ReceiverMap* receiver, std::vector<DepositSum>& sums,
+                        std::vector<std::vector<std::uint32_t>>& by_slab) {
   const std::size_t count = results.size();
   const glm::dvec3 h = grid.voxelSize();
   const double inv_volume = 1.0 / grid.voxelVolume();
