@@ -17,7 +17,7 @@ function(eikonal_add_tests name)
   endif()
   cmake_parse_arguments(ARG "" "" "SOURCES;SUPPORT;LIBS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES} ${ARG_SUPPORT})
-  target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gtest_main)
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest eikonal_test_main)
   eikonal_warnings(${name})
   target_compile_definitions(${name} PRIVATE EIKONAL_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
                                               EIKONAL_BINARY_DIR="${PROJECT_BINARY_DIR}")

@@ -15,4 +15,4 @@ else
   "$root/scripts/build.sh" "$build"
 fi
 cd "$build"
-ctest --output-on-failure -j"$(nproc 2>/dev/null || echo 2)" --timeout 600
+ctest --output-on-failure -j"$(nproc 2>/dev/null || echo 2)" --timeout 300
