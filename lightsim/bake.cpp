@@ -11,6 +11,7 @@
 #include "core/limits.h"
 #include "core/gaussian_filter.h"
 #include "core/scene.h"
+#include "lightsim/wavefront.h"
 
 namespace eik {
 
@@ -104,6 +105,119 @@ void applyBake(Volume& volume, const BakeResult& result, const LightSpec& light)
   volume.receivers = result.receivers;
   volume.metadata["light"] = light.toJson();
   volume.metadata["bake_stats"] = result.stats.toJson();
+}
+
+nlohmann::json bakeOptionsToJson(const SimulationOptions& o) {
+  nlohmann::json j;
+  j["deposit"] = o.deposit == DepositMode::Max ? "max" : "accumulate";
+  j["deposit_kernel"] = o.deposit_kernel == DepositKernel::Point ? "point" : "track";
+  j["bounces"] = o.bounces;
+  j["integrator"] = o.integrator == Integrator::RK4 ? "rk4" : o.integrator == Integrator::RK2 ? "rk2" : "euler";
+  j["step_voxels"] = o.step_voxels;
+  j["patch_voxels"] = o.patch_voxels;
+  j["split_voxels"] = o.split_voxels;
+  j["split_rule"] = o.split_rule == SplitRule::Quad ? "quad" : "axis";
+  j["max_depth"] = o.max_depth;
+  j["at_max_depth"] = o.at_max_depth == DepthLimit::Kill ? "kill" : "keep";
+  j["flux_threshold"] = o.flux_threshold;
+  j["max_steps"] = o.max_steps;
+  j["free_flight"] = o.free_flight;
+  j["boundary_on"] = o.boundary_on;
+  j["boundary_off"] = o.boundary_off;
+  if (o.receiver) {
+    const ReceiverSpec& r = *o.receiver;
+    j["receiver"] = {{"name", r.name},
+                     {"point", vec3Json(r.point)},
+                     {"normal", vec3Json(r.normal)},
+                     {"half_extent", r.half_extent},
+                     {"pitch_voxels", r.pitch_voxels}};
+  }
+  return j;
+}
+
+SimulationOptions bakeOptionsFromJson(const nlohmann::json& j, const std::string& source, SimulationOptions o) {
+  if (!j.is_object()) throw InputError(source, "bake_options", "expected an object");
+  auto where = [](const std::string& key) { return "bake_options." + key; };
+  auto number = [&](const nlohmann::json& in, const std::string& key, double& out, const std::string& path) {
+    if (!in.contains(key)) return;
+    const nlohmann::json& v = in.at(key);
+    if (!v.is_number() || !std::isfinite(v.get<double>())) throw InputError(source, path, "expected a finite number");
+    out = v.get<double>();
+  };
+  auto integer = [&](const std::string& key, int& out) {
+    if (!j.contains(key)) return;
+    const nlohmann::json& v = j.at(key);
+    if (!v.is_number_integer() || v.get<std::int64_t>() < -1000000000 || v.get<std::int64_t>() > 1000000000)
+      throw InputError(source, where(key), "expected an integer");
+    out = v.get<int>();
+  };
+  auto choice = [&](const std::string& key, std::initializer_list<const char*> names) -> int {
+    if (!j.contains(key)) return -1;
+    const nlohmann::json& v = j.at(key);
+    int index = 0;
+    for (const char* name : names) {
+      if (v.is_string() && v.get<std::string>() == name) return index;
+      ++index;
+    }
+    throw InputError(source, where(key), "unknown value " + v.dump(-1, ' ', true));
+  };
+  if (int c = choice("deposit", {"accumulate", "max"}); c >= 0) o.deposit = c ? DepositMode::Max : DepositMode::Accumulate;
+  if (int c = choice("deposit_kernel", {"track", "point"}); c >= 0)
+    o.deposit_kernel = c ? DepositKernel::Point : DepositKernel::Track;
+  if (int c = choice("integrator", {"euler", "rk2", "rk4"}); c >= 0)
+    o.integrator = c == 2 ? Integrator::RK4 : c == 1 ? Integrator::RK2 : Integrator::Euler;
+  if (int c = choice("split_rule", {"axis", "quad"}); c >= 0) o.split_rule = c ? SplitRule::Quad : SplitRule::Axis;
+  if (int c = choice("at_max_depth", {"keep", "kill"}); c >= 0) o.at_max_depth = c ? DepthLimit::Kill : DepthLimit::Keep;
+  integer("bounces", o.bounces);
+  integer("max_depth", o.max_depth);
+  integer("max_steps", o.max_steps);
+  number(j, "step_voxels", o.step_voxels, where("step_voxels"));
+  number(j, "patch_voxels", o.patch_voxels, where("patch_voxels"));
+  number(j, "split_voxels", o.split_voxels, where("split_voxels"));
+  number(j, "flux_threshold", o.flux_threshold, where("flux_threshold"));
+  number(j, "boundary_on", o.boundary_on, where("boundary_on"));
+  number(j, "boundary_off", o.boundary_off, where("boundary_off"));
+  if (j.contains("free_flight")) {
+    if (!j.at("free_flight").is_boolean()) throw InputError(source, where("free_flight"), "expected true or false");
+    o.free_flight = j.at("free_flight").get<bool>();
+  }
+  if (j.contains("receiver")) {
+    const nlohmann::json& r = j.at("receiver");
+    if (!r.is_object()) throw InputError(source, where("receiver"), "expected an object");
+    ReceiverSpec spec;
+    if (r.contains("name")) {
+      if (!r.at("name").is_string()) throw InputError(source, where("receiver.name"), "expected a string");
+      spec.name = r.at("name").get<std::string>();
+    }
+    auto vec3 = [&](const char* key, glm::dvec3& out) {
+      const std::string path = where(std::string("receiver.") + key);
+      if (!r.contains(key)) throw InputError(source, path, "missing");
+      const nlohmann::json& a = r.at(key);
+      if (!a.is_array() || a.size() != 3) throw InputError(source, path, "expected three numbers");
+      for (int i = 0; i < 3; ++i) {
+        if (!a.at(static_cast<std::size_t>(i)).is_number() || !std::isfinite(a.at(static_cast<std::size_t>(i)).get<double>()))
+          throw InputError(source, path, "expected three finite numbers");
+        out[i] = a.at(static_cast<std::size_t>(i)).get<double>();
+      }
+    };
+    vec3("point", spec.point);
+    vec3("normal", spec.normal);
+    const double length = glm::length(spec.normal);
+    if (!(length > 0.0) || !std::isfinite(length)) throw InputError(source, where("receiver.normal"), "must not be zero");
+    spec.normal /= length;
+    number(r, "half_extent", spec.half_extent, where("receiver.half_extent"));
+    number(r, "pitch_voxels", spec.pitch_voxels, where("receiver.pitch_voxels"));
+    if (!(spec.half_extent > 0.0)) throw InputError(source, where("receiver.half_extent"), "must be positive");
+    if (!(spec.pitch_voxels >= 0.01 && spec.pitch_voxels <= 8.0))  // lightsim --receiver-pitch's range
+      throw InputError(source, where("receiver.pitch_voxels"), "must lie in [0.01, 8]");
+    o.receiver = spec;
+  }
+  try {
+    validateOptions(o);
+  } catch (const InputError& e) {
+    throw InputError(source + ": bake_options: " + e.what());
+  }
+  return o;
 }
 
 void smoothIrradiance(BakeResult& result, const GridSpec& grid, double sigma_voxels) {

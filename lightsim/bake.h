@@ -17,6 +17,15 @@ namespace eik {
 // volume's grid (3 components, one per voxel).
 void applyBake(Volume& volume, const BakeResult& result, const LightSpec& light);
 
+// The options a bake ran with, as the baked manifest's "bake_options" (`lightsim` writes it;
+// docs/volume-format.md): what a re-bake with another light needs to make the same kind of bake
+// (the viewer window's, viewer/background_bake.h). Not the progress callback or cancel flag.
+nlohmann::json bakeOptionsToJson(const SimulationOptions& options);
+// Back: keys that are absent keep `defaults`' values. InputError naming `source` and the key for a
+// wrong type or an unknown name, and what validateOptions refuses.
+SimulationOptions bakeOptionsFromJson(const nlohmann::json& json, const std::string& source,
+                                      SimulationOptions defaults = {});
+
 // Filters the bake's irradiance with a normalised 3D Gaussian of σ voxels (core/gaussian_filter.h),
 // a reconstruction filter for the deposits at patch midpoints. It keeps the sum of the irradiance
 // except within 3σ of the grid's faces (the borders clamp), and leaves the light direction as it is.

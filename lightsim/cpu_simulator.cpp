@@ -641,6 +641,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   const double total_in = luminance(stats.flux_in);
 
   for (int step = 0; step < max_steps && !patches.empty(); ++step) {
+    if (options.cancel && options.cancel->load(std::memory_order_relaxed)) throw BakeCancelled();
     const std::size_t count = patches.size();
     stats.steps = step + 1;
     stats.peak_patches = std::max<std::uint64_t>(stats.peak_patches, count);

@@ -349,6 +349,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   };
 
   for (int s = 0; s < maxSteps && count > 0; ++s) {
+    if (options.cancel && options.cancel->load(std::memory_order_relaxed)) throw BakeCancelled();
     stats.steps = s + 1;
     stats.total_patches += count;
     stats.peak_patches = std::max<std::uint64_t>(stats.peak_patches, count);  // live at a step's start

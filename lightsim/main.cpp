@@ -203,6 +203,7 @@ int run(int argc, char** argv) {
 
   if (smooth_irradiance > 0.0) smoothIrradiance(result, volume.grid, smooth_irradiance);
   applyBake(volume, result, light);
+  volume.metadata["bake_options"] = bakeOptionsToJson(options);
   if (smooth_irradiance > 0.0) volume.metadata["irradiance_smoothing_sigma_voxels"] = smooth_irradiance;
   VolumeWriteOptions write;
   write.gzip = !raw;

@@ -4,10 +4,12 @@
 // GPU path and which serves as a fallback. makeSimulator (make_simulator.h) picks one.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -82,6 +84,14 @@ struct SimulationOptions {
   double boundary_on = 0.02;      // |∇n|·h entering a boundary layer (Fresnel tracking)
   double boundary_off = 0.01;     // |∇n|·h leaving it
   ProgressFn progress;            // fraction of the entering flux retired (dead or exited)
+  // Set by another thread (the viewer window's background re-bake, viewer/background_bake.h): the
+  // run stops at its next step and throws BakeCancelled. Null: never cancelled.
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+// What Simulator::run throws when SimulationOptions::cancel was set: the bake was abandoned.
+struct BakeCancelled : std::runtime_error {
+  BakeCancelled() : std::runtime_error("the bake was cancelled") {}
 };
 
 struct KillCounts {

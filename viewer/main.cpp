@@ -11,6 +11,7 @@
 //
 // Headless rendering goes through OSMesa/EGL and viewer/scene_renderer.h (the image formation of
 // thesis §5 over every object of the scene, the ground and the environment).
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -96,6 +97,16 @@ int run(int argc, char** argv) {
                  "with --window-frames: OUT.exr (the window's linear image) or OUT.png (its screen pixels); repeatable")
       ->allow_extra_args(false)
       ->group("Scripted window (tests, screenshots)");
+  std::vector<double> window_light;
+  app.add_option("--window-light", window_light,
+                 "with --window-frames: after the first frame, move the light to AZ,EL degrees (as the panel's "
+                 "sliders do) and save once its re-bake has landed")
+      ->delimiter(',')
+      ->expected(2)
+      ->group("Scripted window (tests, screenshots)");
+  bool no_rebake = false;
+  app.add_flag("--no-rebake", no_rebake,
+               "window: the light sliders move only the unbaked light (ground, sun), no background re-bake");
   std::string save_ui;
   app.add_option("--save-ui", save_ui, "with --window-frames: OUT.png of the screen with the controls panel")
       ->group("Scripted window (tests, screenshots)");
@@ -121,6 +132,12 @@ int run(int argc, char** argv) {
     throw InputError("command line", "--save", "--window-frames N and --save OUT go together");
   if (window_frames > 0 && !window_mode)
     throw InputError("command line", "--window-frames", "is for the window: leave out --render and --bench");
+  if (!window_light.empty() && window_frames == 0)
+    throw InputError("command line", "--window-light", "goes with --window-frames N and --save OUT");
+  if (!window_light.empty() && (!std::isfinite(window_light[0]) || !(std::fabs(window_light[1]) <= 89.0)))
+    throw InputError("command line", "--window-light", "expected AZ,EL in degrees with |EL| <= 89");
+  if (!window_light.empty() && no_rebake)
+    throw InputError("command line", "--window-light", "needs the re-bake: leave out --no-rebake");
   for (const std::string& path : save_paths) {
     std::string ext = fs::path(path).extension().string();
     if (ext != ".png" && ext != ".exr") throw InputError("--save", path, "the output must end in .png or .exr");
@@ -190,6 +207,8 @@ int run(int argc, char** argv) {
     options.scripted_frames = window_frames;
     options.save.assign(save_paths.begin(), save_paths.end());
     options.save_ui = save_ui;
+    if (!window_light.empty()) options.scripted_light = glm::dvec2(window_light[0], window_light[1]);
+    options.rebake = !no_rebake;
     options.quiet = quiet;
     return runViewerWindow(scene, settings, camera, options);
   }

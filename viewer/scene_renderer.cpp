@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -98,6 +99,35 @@ struct SceneRenderer::Impl {
       o.has_receiver = true;
       return;
     }
+  }
+
+  // One object's textures, bounds and shader defines, from its volume (the constructor, replaceVolume).
+  Object makeObject(const LoadedObject& loaded) const {
+    loaded.volume.require("ior", 1, loaded.source);
+    loaded.volume.require("ior_grad", 3, loaded.source);
+    Object o;
+    o.source = loaded.source;
+    o.grid = loaded.volume.grid;
+    o.to_world = loaded.object_to_world;
+    o.to_volume = glm::inverse(loaded.object_to_world);
+    o.has_dispersion = loaded.volume.has("dispersion");
+    o.has_region = activeRegion(loaded.volume, o.region_min, o.region_max);
+    absorbingRegion(loaded.volume, o.absorbing_min, o.absorbing_max);
+    o.sharp_faces = materialTouchesBox(loaded.volume);
+    gl::VolumeTextureOptions options;
+    options.source = loaded.source;
+    options.padToRGBA = true;  // llvmpipe samples RGBA32F faster than RGB32F (σa: about 10 % a frame)
+    o.textures = gl::VolumeTextures(loaded.volume, options);
+    const gl::VolumeFieldSlot* ior = o.textures.layout().find("ior");
+    const gl::VolumeFieldSlot* grad = o.textures.layout().find("ior_grad");
+    if (!ior || !grad || ior->texture != grad->texture || ior->channel != 0 || grad->channel != 1)
+      throw RuntimeError("viewer: expected ior and ior_grad together in one RGBA texture");
+    o.defines = interfaceDefines(interfaceTable(loaded.volume, loaded.source));
+    if (scene.ground) attachReceiver(o, loaded, *scene.ground);
+    if (o.has_receiver) o.defines += "#define HAS_RECEIVER 1\n";
+    const std::vector<float> bricks = homogeneousBricks(loaded.volume, o.brick_dims);
+    o.bricks = gl::Texture3D(o.brick_dims, gl::TextureFormat::R32F, bricks, 1, gl::Sampling{gl::Filter::Nearest});
+    return o;
   }
 
   gl::ShaderDefines defines() const {
@@ -225,36 +255,8 @@ SceneRenderer::SceneRenderer(const gl::ShaderLibrary& shaders, const LoadedScene
   glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &max_units);
   int units = s.environment.kind() == EnvironmentKind::Map ? 1 : 0;
   for (const LoadedObject& loaded : scene.objects) {
-    loaded.volume.require("ior", 1, loaded.source);
-    loaded.volume.require("ior_grad", 3, loaded.source);
-    Impl::Object o;
-    o.source = loaded.source;
-    o.grid = loaded.volume.grid;
-    o.to_world = loaded.object_to_world;
-    o.to_volume = glm::inverse(loaded.object_to_world);
-    o.has_dispersion = loaded.volume.has("dispersion");
-    o.has_region = activeRegion(loaded.volume, o.region_min, o.region_max);
-    absorbingRegion(loaded.volume, o.absorbing_min, o.absorbing_max);
-    o.sharp_faces = materialTouchesBox(loaded.volume);
-    gl::VolumeTextureOptions options;
-    options.source = loaded.source;
-    options.padToRGBA = true;  // llvmpipe samples RGBA32F faster than RGB32F (σa: about 10 % a frame)
-    o.textures = gl::VolumeTextures(loaded.volume, options);
-    const gl::VolumeFieldSlot* ior = o.textures.layout().find("ior");
-    const gl::VolumeFieldSlot* grad = o.textures.layout().find("ior_grad");
-    if (!ior || !grad || ior->texture != grad->texture || ior->channel != 0 || grad->channel != 1)
-      throw RuntimeError("viewer: expected ior and ior_grad together in one RGBA texture");
-    units += o.textures.layout().textureCount() + 1;
-    o.defines = interfaceDefines(interfaceTable(loaded.volume, loaded.source));
-    if (scene.scene.ground) Impl::attachReceiver(o, loaded, *scene.scene.ground);
-    if (o.has_receiver) {
-      o.defines += "#define HAS_RECEIVER 1\n";
-      ++units;
-    }
-    {
-      const std::vector<float> bricks = homogeneousBricks(loaded.volume, o.brick_dims);
-      o.bricks = gl::Texture3D(o.brick_dims, gl::TextureFormat::R32F, bricks, 1, gl::Sampling{gl::Filter::Nearest});
-    }
+    Impl::Object o = s.makeObject(loaded);
+    units += o.textures.layout().textureCount() + 1 + (o.has_receiver ? 1 : 0);
     s.objects.push_back(std::move(o));
   }
   if (units > max_units)
@@ -284,6 +286,18 @@ void SceneRenderer::setLightDirection(glm::dvec3 world_dir) {
 }
 
 glm::dvec3 SceneRenderer::lightDirection() const { return impl_->light_direction; }
+
+void SceneRenderer::replaceVolume(int index, const LoadedObject& object) {
+  if (index < 0 || index >= objectCount()) throw std::out_of_range("SceneRenderer::replaceVolume: no such object");
+  Impl& s = *impl_;
+  Impl::Object replacement = s.makeObject(object);
+  Impl::Object& old = s.objects[static_cast<std::size_t>(index)];
+  const bool same_shader = replacement.defines == old.defines && replacement.sharp_faces == old.sharp_faces &&
+                           replacement.textures.layout().glslDefines() == old.textures.layout().glslDefines();
+  old = std::move(replacement);
+  if (!same_shader) s.program_key.clear();  // buildProgram compiles anew
+  s.buildProgram();
+}
 
 int SceneRenderer::objectCount() const { return static_cast<int>(impl_->objects.size()); }
 

@@ -51,6 +51,10 @@ class SceneRenderer {
   Image render(const Camera& camera, glm::ivec2 size);
 
   int objectCount() const;  // objects drawn (all of the scene's)
+  // Replaces object `index`'s volume (a fresh bake of it: viewer/background_bake.h) and uploads it;
+  // recompiles the shader only when what selects its variant changed (its fields, interfaces,
+  // receiver). Same errors as the constructor; std::out_of_range for a bad index.
+  void replaceVolume(int index, const LoadedObject& object);
 
  private:
   struct Impl;

@@ -18,6 +18,7 @@
 #include "gl/context.h"
 #include "gl/framebuffer.h"
 #include "gl/shader_library.h"
+#include "viewer/background_bake.h"
 #include "viewer/display_pass.h"
 #include "viewer/orbit_camera.h"
 #include "viewer/scene_renderer.h"
@@ -171,6 +172,14 @@ int runViewerWindow(const LoadedScene& scene, const RenderSettings& initial_sett
   float resolution_scale = 1.0f;
   bool show_panel = true;
 
+  // The background re-bake of the scene's baked objects when the light moves.
+  std::unique_ptr<BackgroundBake> rebake;
+  if (options.rebake) rebake = std::make_unique<BackgroundBake>(scene);
+  if (rebake && !rebake->enabled()) rebake.reset();
+  std::string bake_line = rebake ? "bake: as loaded" : "";
+  bool scripted_light_moved = false;
+  int baked_frame = 0;  // scripted light: the last frame at which its re-bake was still under way
+
   gl::Framebuffer hdr;
   bool dirty = true;
   double render_ms = 0.0;
@@ -198,7 +207,7 @@ int runViewerWindow(const LoadedScene& scene, const RenderSettings& initial_sett
   };
 
   while (!context.shouldClose()) {
-    if (scripted || dirty)
+    if (scripted || dirty || (rebake && rebake->busy()))
       gl::GlContext::pollEvents();
     else
       glfwWaitEventsTimeout(0.1);  // nothing to render: sleep until input (or a tick for the panel)
@@ -241,11 +250,27 @@ int runViewerWindow(const LoadedScene& scene, const RenderSettings& initial_sett
       ImGui::SliderFloat("exposure (EV)", &exposure, -10.0f, 10.0f, "%.2f");
       ImGui::Combo("tone map", &tonemap, kToneMapperNames, 3);
       bool light_changed = ImGui::SliderFloat("light azimuth", &light_azimuth, -180.0f, 180.0f, "%.0f deg");
+      bool light_dragged = ImGui::IsItemActive();
+      bool light_released = ImGui::IsItemDeactivatedAfterEdit();
       light_changed |= ImGui::SliderFloat("light elevation", &light_elevation, -89.0f, 89.0f, "%.0f deg");
-      if (ImGui::IsItemHovered()) ImGui::SetTooltip("the ground and the sky's sun; a volume's irradiance is baked");
-      if (light_changed) {
-        renderer.setLightDirection(lightDirectionFromAngles(light_azimuth, light_elevation, up));
+      light_dragged |= ImGui::IsItemActive();
+      light_released |= ImGui::IsItemDeactivatedAfterEdit();
+      if (ImGui::IsItemHovered())
+        ImGui::SetTooltip(rebake ? "re-bakes the scene's objects: coarse while dragging, full on release"
+                                 : "the ground and the sky's sun (no re-bake: --no-rebake, or nothing baked)");
+      if (light_changed || light_released) {
+        const glm::dvec3 direction = lightDirectionFromAngles(light_azimuth, light_elevation, up);
+        renderer.setLightDirection(direction);
+        if (rebake) rebake->request(direction, light_dragged ? BakeQuality::Coarse : BakeQuality::Full);
         dirty = true;
+      }
+      if (rebake) {
+        if (rebake->busy())
+          ImGui::Text("bake: %.0f %% (%s)", 100.0 * rebake->progress(),
+                      rebake->runningQuality() == BakeQuality::Coarse ? "coarse" : "full");
+        else
+          ImGui::TextUnformatted(bake_line.c_str());
+        if (!rebake->lastError().empty()) ImGui::TextWrapped("bake failed: %s", rebake->lastError().c_str());
       }
       if (ImGui::SliderFloat("step (voxels)", &step, 0.05f, 4.0f, "%.2f", ImGuiSliderFlags_Logarithmic))
         wanted.step_voxels = step;
@@ -283,6 +308,34 @@ int runViewerWindow(const LoadedScene& scene, const RenderSettings& initial_sett
       dirty = true;
     }
 
+    // Bakes that landed: swap each object's fresh volume in.
+    if (rebake) {
+      for (BackgroundBake::Landed& landed : rebake->take()) {
+        try {
+          renderer.replaceVolume(landed.index, landed.object);
+          bake_line = std::string("bake: ") + (landed.quality == BakeQuality::Coarse ? "coarse " : "full ") +
+                      std::to_string(static_cast<int>(std::lround(landed.seconds * 1e3))) + " ms";
+        } catch (const std::exception& e) {
+          status = std::string("could not show the bake: ") + e.what();
+        }
+        dirty = true;
+        if (!options.quiet)
+          std::fprintf(stderr, "viewer: re-baked %s (%s) in %.2f s\n", landed.object.source.c_str(),
+                       landed.quality == BakeQuality::Coarse ? "coarse" : "full", landed.seconds);
+      }
+    }
+    if (scripted && options.scripted_light && frame == 1 && !scripted_light_moved) {
+      light_azimuth = static_cast<float>(options.scripted_light->x);
+      light_elevation = static_cast<float>(options.scripted_light->y);
+      const glm::dvec3 direction = lightDirectionFromAngles(light_azimuth, light_elevation, up);
+      renderer.setLightDirection(direction);
+      if (rebake) rebake->request(direction, BakeQuality::Full);
+      scripted_light_moved = true;
+      baked_frame = frame + 1;  // this frame's render cannot show the bake yet
+    }
+    if (scripted && rebake && !rebake->lastError().empty())
+      throw RuntimeError("the re-bake failed: " + rebake->lastError());
+
     // Render the HDR image when something changed (always, in scripted mode).
     // While a mouse button drags the view, a quarter of the resolution at most: llvmpipe takes about
     // a second for a full 512² frame. The full image comes back when the button is released.
@@ -313,8 +366,12 @@ int runViewerWindow(const LoadedScene& scene, const RenderSettings& initial_sett
       glm::ivec2 window_size(0);
       glfwGetWindowSize(window, &window_size.x, &window_size.y);
       const bool resized = !resize || (window_size == options.scripted_resize && hdr.size() == fb);
-      last_scripted_frame = frame >= options.scripted_frames && resized;
-      if (frame >= options.scripted_frames + 1000)
+      // A scripted light move waits for its re-bake to land (and be rendered: the swap is done
+      // before this frame's render, so a frame after the bake went idle shows it).
+      const bool baked = !options.scripted_light || (scripted_light_moved && (!rebake || !rebake->busy()));
+      if (!baked) baked_frame = frame;
+      last_scripted_frame = frame >= options.scripted_frames && resized && baked && frame > baked_frame + 1;
+      if (frame >= options.scripted_frames + 1000 && !(options.scripted_light && !baked))
         throw RuntimeError("the window did not take the size asked for (" + std::to_string(options.scripted_resize.x) +
                            "x" + std::to_string(options.scripted_resize.y) + ")");
     }

@@ -5,9 +5,12 @@
 // Controls: left drag orbits, right or middle drag (or shift + left) pans, the wheel zooms; the
 // panel sets the light direction, exposure, tone mapper, step size, integrator, resolution scale
 // and switches refraction, scattering, Fresnel, attenuation, emission, dispersion and the ground;
-// it shows the render time. S saves the current view as EXR (linear) and PNG (tone-mapped exactly
-// as `--render OUT.png`), R resets the camera, Esc or Q quits. The image is re-rendered only when
-// something changed (llvmpipe is slow), at reduced resolution while dragging; the panel stays live.
+// it shows the render time. Moving the light re-bakes the scene's baked objects in the background
+// (a coarse bake while dragging, the full one on release; viewer/background_bake.h) and swaps each
+// in when it lands, so the caustics and shadows follow; the panel shows the bake's progress and time.
+// S saves the current view as EXR (linear) and PNG (tone-mapped exactly as `--render OUT.png`),
+// R resets the camera, Esc or Q quits. The image is re-rendered only when something changed
+// (llvmpipe is slow), at reduced resolution while dragging; the panel stays live.
 //
 // Scripted mode (tests, --window-frames N): renders N frames at full resolution (optionally
 // resizing the window after the first), then writes each `save` path (.exr: the window's linear HDR image; .png: the pixels the display pass put on the
@@ -15,6 +18,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,6 +43,12 @@ struct WindowOptions {
   bool scripted_shot = false;  // scripted mode: also "press S" on the last frame (tests)
   glm::ivec2 scripted_resize{0};  // scripted mode: resize the window to this after the first frame
                                   // (tests), and go on until the window has taken the new size
+  // The light sliders re-bake every object baked by a directional light in the background
+  // (viewer/background_bake.h); off: they move only the ground's and the sun's light.
+  bool rebake = true;
+  // Scripted mode: after the first frame, move the light to these angles (azimuth, elevation in
+  // degrees, as the sliders) and go on until its re-bake has landed (tests).
+  std::optional<glm::dvec2> scripted_light;
   bool quiet = false;
 };
 
