@@ -15,6 +15,7 @@
 #include "lightsim/interface_crossing.h"
 #include "lightsim/test_scenes.h"
 #include "tests/reference/exact_optics.h"
+#include "tests/reference/map_binning.h"
 
 namespace eik {
 namespace {
@@ -99,18 +100,8 @@ struct SphereBake {
 // The exact tracer's flux binned into `map`'s texels, as a map of planar irradiance.
 ReceiverMap exactThroughMap(const ReceiverMap& map) {
   reference::Receiver receiver;
-  receiver.map_texels = map.texels.x;
-  receiver.map_pitch = map.pitch;
-  receiver.map_u = map.u;
-  receiver.map_v = map.v;
-  receiver.map_origin_given = true;
-  receiver.map_origin = map.origin;
-  const reference::ReceiverTally tally = traceSphereOnFloor(receiver);
-  ReceiverMap exact = map;
-  for (std::size_t t = 0; t < map.texelCount(); ++t)
-    for (int c = 0; c < 3; ++c)
-      exact.irradiance[3 * t + static_cast<std::size_t>(c)] = static_cast<float>(tally.map_flux[t] / (map.pitch * map.pitch));
-  return exact;
+  reference::binLikeMap(map, receiver);
+  return reference::irradianceLikeMap(map, traceSphereOnFloor(receiver));
 }
 
 SphereBake bakeSphereOnFloor(int res, bool free_flight = true) {

@@ -5,7 +5,7 @@
 // lightsim/bake.h), so the window stays live. Each object's fresh volume lands as it finishes and
 // the window swaps it in (SceneRenderer::replaceVolume).
 //
-// Progressive: a coarse bake (patches and split length twice as large, a quarter of the patches)
+// Progressive: a coarse bake (patches, split length and receiver texels twice as large)
 // while the slider is dragged, the full one on release. A new request cancels a bake under way
 // (SimulationOptions::cancel) except a coarse one while another coarse one is asked for: that one
 // finishes first, so that something lands while dragging, and the newest request runs next.
@@ -46,8 +46,9 @@ struct RebakeSource {
 // receiver in the volume's space). InputError naming the manifest for malformed "bake_options".
 std::vector<RebakeSource> rebakeSources(const LoadedScene& scene);
 
-// The options of a coarse bake: initial patch and split length doubled (a quarter of the patches,
-// each depositing over twice the length), the rest as given.
+// The options of a coarse bake: initial patch and split length doubled (a quarter of the patches
+// at the start, about a third of the patch-steps) and the receiver map's texels twice as large (a
+// quarter of the texels), the rest as given.
 SimulationOptions coarseOptions(SimulationOptions options);
 
 // The bake of `source` with a light travelling along `world_direction` (transformed into the

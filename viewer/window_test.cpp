@@ -84,6 +84,18 @@ TEST(ViewerWindow, LightAnglesRoundTrip) {
     }                                                                                                \
   } while (false)
 
+// Runs the scripted window; a window that cannot open skips the test (fails under
+// EIKONAL_REQUIRE_DISPLAY), and so does any RuntimeError of the run there.
+#define RUN_WINDOW_OR_SKIP(scene, settings, camera, options)                   \
+  do {                                                                         \
+    try {                                                                      \
+      ASSERT_EQ(runViewerWindow(scene, settings, camera, options), 0);         \
+    } catch (const RuntimeError& e) {                                          \
+      if (std::getenv("EIKONAL_REQUIRE_DISPLAY") != nullptr) FAIL() << e.what(); \
+      GTEST_SKIP() << e.what();                                                \
+    }                                                                          \
+  } while (false)
+
 TEST(ViewerWindow, WindowImageEqualsHeadlessImageUnderADisplay) {
   SKIP_WITHOUT_DISPLAY();
   test_support::TempDir dir("eikonal-window-test");
@@ -121,12 +133,7 @@ TEST(ViewerWindow, WindowImageEqualsHeadlessImageUnderADisplay) {
   options.quiet = true;
   options.shot_prefix = dir / "shot";
   options.scripted_shot = true;
-  try {
-    ASSERT_EQ(runViewerWindow(scene, settings, camera, options), 0);
-  } catch (const RuntimeError& e) {
-    if (std::getenv("EIKONAL_REQUIRE_DISPLAY") != nullptr) FAIL() << e.what();
-    GTEST_SKIP() << e.what();
-  }
+  RUN_WINDOW_OR_SKIP(scene, settings, camera, options);
 
   // HDR: both went through the EXR writer (half floats), so equal renders give equal files; the
   // tolerance, one half-float step (2^-10 relative), absorbs a last-bit difference between the two
@@ -203,12 +210,7 @@ TEST(ViewerWindow, ResizedWindowRendersAtItsNewSize) {
   options.scripted_resize = resized;
   options.save = {dir / "window.exr"};
   options.quiet = true;
-  try {
-    ASSERT_EQ(runViewerWindow(scene, settings, camera, options), 0);
-  } catch (const RuntimeError& e) {
-    if (std::getenv("EIKONAL_REQUIRE_DISPLAY") != nullptr) FAIL() << e.what();
-    GTEST_SKIP() << e.what();
-  }
+  RUN_WINDOW_OR_SKIP(scene, settings, camera, options);
   Image headless;
   {
     gl::GlContext context;
@@ -247,12 +249,7 @@ TEST(ViewerWindow, ALightMoveRebakesAndTheCausticFollows) {
   options.scripted_light = glm::dvec2(90.0, 60.0);
   options.save = {dir / "window.exr", dir / "window.png"};
   options.quiet = true;
-  try {
-    ASSERT_EQ(runViewerWindow(scene, settings, camera, options), 0);
-  } catch (const RuntimeError& e) {
-    if (std::getenv("EIKONAL_REQUIRE_DISPLAY") != nullptr) FAIL() << e.what();
-    GTEST_SKIP() << e.what();
-  }
+  RUN_WINDOW_OR_SKIP(scene, settings, camera, options);
 
   // Headless: the scene as loaded, and the scene baked afresh with the sun at azimuth 90°.
   LoadedScene fresh = test_scenes::bakedScene(test_scenes::directional(test_scenes::sunAt(90.0)));

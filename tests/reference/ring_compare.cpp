@@ -41,6 +41,7 @@
 #include "core/receiver_map.h"
 #include "core/volume.h"
 #include "tests/reference/exact_optics.h"
+#include "tests/reference/map_binning.h"
 
 namespace {
 
@@ -211,12 +212,7 @@ json modeTrace(std::uint64_t rays, std::uint64_t seed, int threads, const std::s
     if (volume.receivers.empty()) throw std::runtime_error(through_map + ": no receiver map");
     map = volume.receivers.front();
     if (map.texels.x != map.texels.y) throw std::runtime_error(through_map + ": the tracer's map must be square");
-    receiver.map_texels = map.texels.x;
-    receiver.map_pitch = map.pitch;
-    receiver.map_u = map.u;
-    receiver.map_v = map.v;
-    receiver.map_origin_given = true;
-    receiver.map_origin = map.origin;
+    eik::reference::binLikeMap(map, receiver);
   }
   eik::reference::TraceOptions options;
   options.rays = rays;
