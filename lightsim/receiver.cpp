@@ -86,6 +86,59 @@ double polygonArea(const glm::dvec2* p, int count) {
   return 0.5 * std::abs(twice);
 }
 
+// Adds density × area(polygon ∩ texel) to each texel of one row (`row`: its first texel) for a
+// convex polygon lying within the row. The polygon's vertical extent h(x) is piecewise linear
+// between its vertices' x (continuous and concave inside, as the polygon is convex), so its
+// integral H(x) is piecewise quadratic and a texel's overlap is H(x₁) − H(x₀): exact, and a few
+// operations a texel instead of a clip.
+void depositRow(const ReceiverMap& map, const glm::dvec2* p, int n, const glm::dvec3& density, glm::dvec3* row) {
+  double xs[8];
+  for (int k = 0; k < n; ++k) xs[k] = p[k].x;
+  std::sort(xs, xs + n);
+  // The extent at each breakpoint: the chord of the vertical line x (with a vertical edge at the
+  // polygon's left or right end, its whole length: the limit from inside).
+  double hs[8];
+  for (int k = 0; k < n; ++k) {
+    const double x = xs[k];
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (int e = 0; e < n; ++e) {
+      const glm::dvec2 u = p[e], v = p[(e + 1) % n];
+      if (x < std::min(u.x, v.x) || x > std::max(u.x, v.x)) continue;
+      if (u.x == v.x) {
+        lo = std::min(lo, std::min(u.y, v.y)), hi = std::max(hi, std::max(u.y, v.y));
+      } else {
+        const double y = u.y + (x - u.x) / (v.x - u.x) * (v.y - u.y);
+        lo = std::min(lo, y), hi = std::max(hi, y);
+      }
+    }
+    hs[k] = hi > lo ? hi - lo : 0.0;
+  }
+  // H at the breakpoints (trapezoids), and H(x) within a segment.
+  double cumulative[8];
+  cumulative[0] = 0.0;
+  for (int k = 0; k + 1 < n; ++k) cumulative[k + 1] = cumulative[k] + 0.5 * (hs[k] + hs[k + 1]) * (xs[k + 1] - xs[k]);
+  int segment = 0;
+  auto integral = [&](double x) {  // H(x), for non-decreasing x from call to call
+    while (segment + 2 < n && x > xs[segment + 1]) ++segment;
+    const double width = xs[segment + 1] - xs[segment];
+    if (!(width > 0.0)) return cumulative[segment + 1];
+    const double t = std::clamp(x - xs[segment], 0.0, width);
+    const double slope = (hs[segment + 1] - hs[segment]) / width;
+    return cumulative[segment] + t * (hs[segment] + 0.5 * slope * t);
+  };
+  const double xmin = xs[0], xmax = xs[n - 1];
+  const int i0 = std::max(0, static_cast<int>(std::floor((xmin - map.origin.x) / map.pitch)));
+  const int i1 = std::min(map.texels.x - 1, static_cast<int>(std::floor((xmax - map.origin.x) / map.pitch)));
+  if (i0 > i1) return;
+  double left = integral(std::max(xmin, map.origin.x + i0 * map.pitch));
+  for (int i = i0; i <= i1; ++i) {
+    const double right = integral(std::min(xmax, map.origin.x + (i + 1) * map.pitch));
+    const double overlap = right - left;
+    if (overlap > 0.0) row[i] += density * overlap;
+    left = right;
+  }
+}
+
 void depositTriangle(const ReceiverMap& map, const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c,
                      const glm::dvec3& flux, std::vector<glm::dvec3>& texel_flux, int row_begin, int row_end) {
   const double area = 0.5 * std::abs(cross2(b - a, c - a));
@@ -102,42 +155,15 @@ void depositTriangle(const ReceiverMap& map, const glm::dvec2& a, const glm::dve
   const int j0 = std::max(std::max(0, row_begin), static_cast<int>(std::floor(lo.y)));
   const int j1 = std::min(std::min(map.texels.y, row_end) - 1, static_cast<int>(std::floor(hi.y)));
   const glm::dvec3 density = flux / area;
-  // Edge functions, positive inside (whatever the winding): a texel with its four corners inside
-  // all three is covered whole, one with its four corners outside one of them not at all; only the
-  // texels an edge passes through are clipped.
-  const double orient = cross2(b - a, c - a) > 0.0 ? 1.0 : -1.0;
-  const glm::dvec2 p0[3] = {a, b, c}, p1[3] = {b, c, a};
-  auto edge = [&](int e, const glm::dvec2& q) { return orient * cross2(p1[e] - p0[e], q - p0[e]); };
-  const double texel_area = map.pitch * map.pitch;
   for (int j = j0; j <= j1; ++j) {
-    // The triangle's extent within this row of texels (clipped to the row), so that a long thin
-    // footprint (light grazing the plane) costs the texels it touches, not its bounding box.
+    // The triangle within this row of texels (clipped to the row): a convex polygon whose overlap
+    // with each texel of the row is the integral of its vertical extent over the texel's columns.
     const double y0 = map.origin.y + j * map.pitch, y1 = y0 + map.pitch;
     glm::dvec2 buffer_a[8] = {a, b, c}, buffer_b[8];
     int n = clipAgainst(buffer_a, 3, buffer_b, 1, y0, -1.0);
     n = clipAgainst(buffer_b, n, buffer_a, 1, y1, 1.0);
     if (n < 3) continue;
-    double xmin = buffer_a[0].x, xmax = buffer_a[0].x;
-    for (int k = 1; k < n; ++k) xmin = std::min(xmin, buffer_a[k].x), xmax = std::max(xmax, buffer_a[k].x);
-    const int i0 = std::max(0, static_cast<int>(std::floor((xmin - map.origin.x) / map.pitch)));
-    const int i1 = std::min(map.texels.x - 1, static_cast<int>(std::floor((xmax - map.origin.x) / map.pitch)));
-    for (int i = i0; i <= i1; ++i) {
-      const glm::dvec2 tlo = map.origin + glm::dvec2(i, j) * map.pitch;
-      const glm::dvec2 corners[4] = {tlo, tlo + glm::dvec2(map.pitch, 0.0), tlo + glm::dvec2(0.0, map.pitch),
-                                     tlo + glm::dvec2(map.pitch)};
-      bool all_inside = true, outside_one = false;
-      for (int e = 0; e < 3 && !outside_one; ++e) {
-        int inside = 0;
-        for (const glm::dvec2& q : corners) inside += edge(e, q) >= 0.0 ? 1 : 0;
-        if (inside != 4) all_inside = false;
-        if (inside == 0) outside_one = true;
-      }
-      if (outside_one) continue;
-      const double overlap = all_inside ? texel_area : triangleSquareOverlap(a, b, c, tlo, tlo + glm::dvec2(map.pitch));
-      if (overlap > 0.0)
-        texel_flux[static_cast<std::size_t>(j) * static_cast<std::size_t>(map.texels.x) + static_cast<std::size_t>(i)] +=
-            density * overlap;
-    }
+    depositRow(map, buffer_a, n, density, &texel_flux[static_cast<std::size_t>(j) * static_cast<std::size_t>(map.texels.x)]);
   }
 }
 
