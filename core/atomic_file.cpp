@@ -1,10 +1,12 @@
 #include "core/atomic_file.h"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <random>
@@ -13,6 +15,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/interrupt.h"
 
 namespace eik {
 namespace fs = std::filesystem;
@@ -39,6 +42,25 @@ fs::path directoryOf(const fs::path& target) {
 }
 
 }  // namespace
+
+void removeStaleTemporaries(const fs::path& target) noexcept {
+  const std::string prefix = "." + target.filename().string() + ".tmp-";
+  std::error_code ec;
+  for (fs::directory_iterator it(directoryOf(target), ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    const char* digits = name.c_str() + prefix.size();
+    char* after = nullptr;
+    errno = 0;
+    const long pid = std::strtol(digits, &after, 10);
+    if (after == digits || *after != '-' || errno == ERANGE || pid <= 0 || pid == ::getpid()) continue;
+    // Only a process that no longer exists: kill(pid, 0) fails with ESRCH. A live one (or one we
+    // may not signal, EPERM) may still be writing.
+    if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
+    std::error_code remove_ec;
+    fs::remove(it->path(), remove_ec);
+  }
+}
 
 fs::path temporaryPathFor(const fs::path& target) {
   std::string name = "." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
@@ -75,7 +97,10 @@ fs::path AtomicFileSet::stage(const fs::path& target) {
     throw InputError(target.string(), "", "output directory " + dir.string() + " does not exist");
   }
   if (fs::is_directory(target, ec)) throw InputError(target.string(), "", "is a directory");
-  entries_.push_back({target, temporaryPathFor(target)});
+  removeStaleTemporaries(target);
+  Entry entry{target, temporaryPathFor(target), -1};
+  entry.slot = pending_temporaries::add(entry.temporary.string());  // a signal removes it (interrupt.h)
+  entries_.push_back(std::move(entry));
   return entries_.back().temporary;
 }
 
@@ -99,6 +124,7 @@ void AtomicFileSet::commit() {
   for (std::size_t i = 0; i < entries_.size(); ++i) {
     std::error_code ec;
     fs::rename(entries_[i].temporary, entries_[i].target, ec);
+    if (!ec) pending_temporaries::remove(entries_[i].slot), entries_[i].slot = -1;
     if (ec) {
       std::string message = entries_[i].target.string() + ": cannot move the finished file into place: " +
                             ec.message();
@@ -116,6 +142,7 @@ void AtomicFileSet::discard() noexcept {
   for (const Entry& entry : entries_) {
     std::error_code ec;
     fs::remove(entry.temporary, ec);  // the file may never have been created: ignore errors
+    pending_temporaries::remove(entry.slot);
   }
   entries_.clear();
 }

@@ -2,6 +2,8 @@
 // half-written volume behind"). Every file is first written under a hidden temporary name in its
 // target's directory (`.NAME.tmp-<pid>-<random>`), then renamed into place; rename(2) within one
 // directory replaces the target in one step, so readers see the old file or the new, never a part.
+// SIGINT and SIGTERM remove the temporaries (core/interrupt.h); those a SIGKILL leaves are removed
+// by the next write of the same target.
 #pragma once
 
 #include <filesystem>
@@ -47,6 +49,7 @@ class AtomicFileSet {
   struct Entry {
     std::filesystem::path target;
     std::filesystem::path temporary;
+    int slot = -1;  // in the table a SIGINT/SIGTERM handler cleans (core/interrupt.h)
   };
   std::vector<Entry> entries_;
   bool committed_ = false;
@@ -58,5 +61,9 @@ void writeFileAtomic(const std::filesystem::path& path, std::string_view bytes);
 
 // The temporary name used for `target`: DIR/.NAME.tmp-<pid>-<random>.
 std::filesystem::path temporaryPathFor(const std::filesystem::path& target);
+
+// Removes the temporaries of `target` (.NAME.tmp-<pid>-…) that processes no longer alive left
+// behind (killed by SIGKILL, or a crash). stage() calls it. Never throws.
+void removeStaleTemporaries(const std::filesystem::path& target) noexcept;
 
 }  // namespace eik

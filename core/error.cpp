@@ -4,6 +4,8 @@
 #include <exception>
 #include <new>
 
+#include "core/interrupt.h"
+
 namespace eik {
 
 namespace {
@@ -21,6 +23,7 @@ InputError::InputError(const std::string& source, const std::string& field, cons
     : std::runtime_error(joinMessage(source, field, what)) {}
 
 int runMain(const char* program, int (*body)(int, char**), int argc, char** argv) {
+  installInterruptHandlers(program);
   try {
     return body(argc, argv);
   } catch (const InputError& e) {

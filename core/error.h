@@ -26,7 +26,8 @@ class RuntimeError : public std::runtime_error {
 };
 
 // Runs `body` and turns exceptions into the documented exit codes, printing
-// "PROGRAM: error: MESSAGE" on stderr. Every executable's main() goes through this.
+// "PROGRAM: error: MESSAGE" on stderr, after installing the SIGINT/SIGTERM handlers
+// (core/interrupt.h: exit 130/143, no temporaries left). Every executable's main() goes through this.
 int runMain(const char* program, int (*body)(int, char**), int argc, char** argv);
 
 }  // namespace eik

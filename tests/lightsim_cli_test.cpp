@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -46,6 +48,7 @@ TEST(LightsimCli, BakesOnBothBackends) {
     EXPECT_NEAR(v.fields.at("irradiance").voxel(top)[0], 2.0f, 0.3f) << backend;
     EXPECT_NEAR(v.fields.at("light_dir").voxel(top)[1], -1.0f, 1e-3f) << backend;
     EXPECT_EQ(v.metadata["light"]["type"], "directional");
+    EXPECT_EQ(v.metadata["bake_options"]["max_depth"], 3);  // what the viewer window re-bakes with
     nlohmann::json stats = nlohmann::json::parse(readFile(dir / "stats.json"));
     EXPECT_GT(stats["steps"].get<int>(), 0);
     EXPECT_EQ(stats["backend"], backend);
@@ -201,6 +204,24 @@ TEST(LightsimCli, BadInputExitsTwo) {
     EXPECT_EQ(r.exit_code, 2) << r.output;
     EXPECT_NE(r.output.find(c.expected), std::string::npos) << "expected '" << c.expected << "' in: " << r.output;
     EXPECT_FALSE(std::filesystem::exists(dir / "x.vol.json"));
+  }
+}
+
+// Ctrl-C (SIGINT) or a kill (SIGTERM) during a bake: exit 130 / 143, a message, and no output file
+// or temporary left (core/interrupt.h). The bake repeats (--bench) so that the signal finds it running.
+TEST(LightsimCli, AnInterruptedBakeExits130Or143AndLeavesNothing) {
+  TempDir dir;
+  makeSphere(dir, true);
+  const std::vector<std::string> before = dir.entries();
+  for (const auto& [signal_number, code, word] : {std::tuple<int, int, const char*>{SIGINT, 130, "interrupted"},
+                                                  std::tuple<int, int, const char*>{SIGTERM, 143, "terminated"}}) {
+    ProgramResult r = runProgram(LIGHTSIM_EXE,
+                                 {"sharp.vol.json", "-o", "out.vol.json", "--light", "directional:0,-1,0", "--backend",
+                                  "cpu", "--bench", "1000", "--quiet"},
+                                 dir.path(), signal_number, 1.0);
+    EXPECT_EQ(r.exit_code, code) << r.output;
+    EXPECT_NE(r.output.find(std::string("lightsim: ") + word), std::string::npos) << r.output;
+    EXPECT_EQ(dir.entries(), before) << "an interrupted bake left files behind";
   }
 }
 

@@ -4,12 +4,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <csignal>
 #include <stdexcept>
+#include <thread>
 
 namespace eik::test {
 
 ProgramResult runProgram(const std::string& program, const std::vector<std::string>& args,
-                         const std::filesystem::path& cwd) {
+                         const std::filesystem::path& cwd, int signal_number, double signal_after_s) {
   int pipe_fd[2];
   if (pipe(pipe_fd) != 0) throw std::runtime_error("pipe failed");
   pid_t pid = fork();
@@ -30,6 +33,12 @@ ProgramResult runProgram(const std::string& program, const std::vector<std::stri
     _exit(127);
   }
   close(pipe_fd[1]);
+  std::thread signaller;
+  if (signal_number != 0)
+    signaller = std::thread([pid, signal_number, signal_after_s] {
+      std::this_thread::sleep_for(std::chrono::duration<double>(signal_after_s));
+      kill(pid, signal_number);  // the child is not reaped before this thread is joined
+    });
   ProgramResult result;
   char buffer[4096];
   for (;;) {
@@ -38,6 +47,7 @@ ProgramResult runProgram(const std::string& program, const std::vector<std::stri
     result.output.append(buffer, static_cast<std::size_t>(n));
   }
   close(pipe_fd[0]);
+  if (signaller.joinable()) signaller.join();
   int status = 0;
   waitpid(pid, &status, 0);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);

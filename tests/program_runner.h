@@ -19,8 +19,9 @@ struct ProgramResult {
   std::string output;  // stdout and stderr together
 };
 
-// Runs `program` with `args` in `cwd`; EIKONAL_THREADS etc. are inherited.
+// Runs `program` with `args` in `cwd`; EIKONAL_THREADS etc. are inherited. With `signal_number`,
+// sends it that signal `signal_after_s` seconds after the start (a user's Ctrl-C, a kill).
 ProgramResult runProgram(const std::string& program, const std::vector<std::string>& args,
-                         const std::filesystem::path& cwd);
+                         const std::filesystem::path& cwd, int signal_number = 0, double signal_after_s = 0.0);
 
 }  // namespace eik::test
