@@ -10,6 +10,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/limits.h"
 #include "core/text.h"
 
 namespace eik {
@@ -62,7 +63,16 @@ Image readImage(const std::filesystem::path& path) {
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
     throw InputError(path.string(), "", "image has no pixels");
-  if (spec.width > 32768 || spec.height > 32768) throw InputError(path.string(), "size", "image larger than 32768 pixels");
+  // Before a pixel is allocated: the size a header claims (a 60-byte .hdr may claim 32768²).
+  if (spec.width > kMaxImageAxis || spec.height > kMaxImageAxis)
+    throw InputError(path.string(), "size",
+                     std::to_string(spec.width) + "x" + std::to_string(spec.height) + " is larger than " +
+                         std::to_string(kMaxImageAxis) + " pixels an axis");
+  // The float pixels, and as much again for what is made of them (an environment's mipmaps, a
+  // converted copy).
+  checkMemoryLimit(path.string(), "size",
+                   2ull * static_cast<std::uint64_t>(spec.width) * static_cast<std::uint64_t>(spec.height) *
+                       static_cast<std::uint64_t>(std::min(spec.nchannels, 4)) * sizeof(float));
   Image image;
   image.width = spec.width;
   image.height = spec.height;

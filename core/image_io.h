@@ -29,8 +29,14 @@ struct ImageWriteOptions {
 // tone-mapped sRGB 8-bit. InputError for an unknown extension, RuntimeError when writing fails.
 void writeImage(const std::filesystem::path& path, const Image& image, const ImageWriteOptions& options = {});
 
+// The largest image readImage accepts, per axis (an environment map must fit GL_MAX_TEXTURE_SIZE,
+// 16384 on llvmpipe).
+constexpr int kMaxImageAxis = 16384;
+
 // Reads any format OpenImageIO knows as linear float RGB(A) (sRGB-encoded 8-bit files are
-// linearised). InputError naming the file when it cannot be read.
+// linearised). InputError naming the file when it cannot be read, when its header claims more than
+// kMaxImageAxis pixels an axis or more memory than the machine has (core/limits.h), both checked
+// before a pixel is allocated, or when a pixel is not finite.
 Image readImage(const std::filesystem::path& path);
 
 }  // namespace eik

@@ -77,6 +77,9 @@ TEST(ViewerCli, BadInputExitsTwo) {
   writeFile(dir / "ground_type.json",
             R"({"objects": [{"volume": "ball.vol.json"}], "ground": {"albedo": "grey"}})");
   writeFile(dir / "garbage.exr", "this is not an image");
+  // Radiance headers that claim far more pixels than the file holds.
+  writeFile(dir / "huge.hdr", std::string("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 32768 +X 32768\n") + "\x02\x02\x80\x00");
+  writeFile(dir / "big.hdr", std::string("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 16000 +X 16000\n") + "\x02\x02\x80\x00");
   Volume no_ior = readVolume(dir / "ball.vol.json");
   no_ior.fields.erase("ior");
   writeVolume(no_ior, dir / "noior.vol.json");
@@ -96,6 +99,7 @@ TEST(ViewerCli, BadInputExitsTwo) {
       {{"ball.vol.json", "--render", "x.png", "--env", "missing.exr"}, "missing.exr"},
       {{"ball.vol.json", "--render", "x.png", "--env", "garbage.exr"}, "garbage.exr"},
       {{"env_missing.json", "--render", "x.png"}, "nowhere.exr"},
+      {{"ball.vol.json", "--render", "x.png", "--env", "huge.hdr"}, "huge.hdr: size: 32768x32768 is larger than 16384"},
       {{"env_unknown.json", "--render", "x.png"}, "environment.procedural"},
       {{"ground_type.json", "--render", "x.png"}, "ground.albedo"},
       {{"noior.vol.json", "--render", "x.png"}, "ior"},
@@ -106,6 +110,15 @@ TEST(ViewerCli, BadInputExitsTwo) {
     ProgramResult r = runProgram(VIEWER_EXE, c.args, dir.path());
     EXPECT_EQ(r.exit_code, 2) << c.args[0] << ": " << r.output;
     EXPECT_NE(r.output.find(c.expected), std::string::npos) << "expected '" << c.expected << "' in: " << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
+  }
+  // Within the axis limit but over the machine's memory (here said to be 1 GiB; 16000² RGB floats
+  // and their mipmaps need 5.7 GiB): refused before a pixel is allocated.
+  {
+    test_support::ScopedEnv memory("EIKONAL_MEMORY_LIMIT_BYTES", "1073741824");
+    ProgramResult r = runProgram(VIEWER_EXE, {"ball.vol.json", "--render", "x.png", "--env", "big.hdr"}, dir.path());
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("big.hdr: size"), std::string::npos) << r.output;
     EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
   }
 }
