@@ -12,6 +12,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libimgui-dev
   xvfb xauth
+  clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer harnesses (fuzz/)
   blender-data
 )
 # npm fetches the Stanford bunny (npm package "bunny"); Debian's npm brings Node.js with it.

@@ -90,7 +90,7 @@ ShapeParams::ShapeParams(const std::string& shape_name, const std::vector<ParamD
       if (std::find(def.choices.begin(), def.choices.end(), value) == def.choices.end())
         fail(key, "'" + value + "' is not one of " + joinedList(def.choices));
     } else {
-      auto check = [&](double v) {
+      auto check = [&, &key = key](double v) {  // a structured binding named for clang 14 (fuzz builds)
         const bool below = def.lo_open ? !(v > def.lo) : !(v >= def.lo);
         const bool above = def.hi_open ? !(v < def.hi) : !(v <= def.hi);
         if (below || above) {
