@@ -172,7 +172,7 @@ TEST(BackgroundBake, TheNewestRequestLandsAndAStaleBakeIsCancelled) {
   std::vector<BackgroundBake::Landed> landed = bake.take();
   ASSERT_FALSE(landed.empty());
   ASSERT_LE(landed.size(), 2u);
-  const BackgroundBake::Landed& last = landed.back();
+  const BackgroundBake::Landed last = landed.back();  // a copy: `landed` is reassigned below
   EXPECT_EQ(last.index, 0);
   EXPECT_EQ(last.quality, BakeQuality::Full);
   const LoadedObject expected = rebake(rebakeSources(scene).at(0), sunAt(135.0), BakeQuality::Full);
