@@ -46,7 +46,10 @@ for name in "${names[@]}"; do
   if [ "$mode" = smoke ]; then
     runs=20000
     [ "$name" = image ] && runs=2000  # OpenImageIO opens each input slowly (about 100 a second)
-    args=(-runs="$runs" -seed=1 "$seeds")
+    # New inputs go to a scratch folder emptied first (the first corpus folder is where libFuzzer
+    # writes): the seeds stay as committed, and the run starts from them alone.
+    rm -rf "$build/smoke-corpus/$name" && mkdir -p "$build/smoke-corpus/$name"
+    args=(-runs="$runs" -seed=1 "$build/smoke-corpus/$name" "$seeds")
   else
     args=(-max_total_time="$seconds" -jobs="$jobs" -workers="$jobs" "$build/corpus/$name" "$seeds")
   fi
