@@ -38,8 +38,8 @@ inline glm::dvec3 sunAt(double azimuth_deg) { return lightDirectionFromAngles(az
 
 // The ball baked with `light` as `lightsim --scene` writes it (fields, "light", "bake_options"),
 // as a one-object scene with the floor as its ground.
-inline LoadedScene bakedScene(const LightSpec& light) {
-  Volume volume = test_scenes::sharpVolume("procedural:sphere,r=1,center=0:1.5:0,ior=1.5", kBallRes, std::nullopt, 2.0);
+inline LoadedScene bakedScene(const LightSpec& light, int res = kBallRes) {
+  Volume volume = test_scenes::sharpVolume("procedural:sphere,r=1,center=0:1.5:0,ior=1.5", res, std::nullopt, 2.0);
   const SimulationOptions options = lightsimOptions();
   CpuSimulator simulator(volume);
   applyBake(volume, simulator.run(light, options), light);
