@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <memory>
 #include <random>
 #include <string>
@@ -43,23 +44,30 @@ fs::path directoryOf(const fs::path& target) {
 
 }  // namespace
 
-void removeStaleTemporaries(const fs::path& target) noexcept {
-  const std::string prefix = "." + target.filename().string() + ".tmp-";
+void removeStaleTemporaries(const fs::path& dir, const std::function<bool(const std::string&)>& of_target) noexcept {
   std::error_code ec;
-  for (fs::directory_iterator it(directoryOf(target), ec), end; !ec && it != end; it.increment(ec)) {
+  for (fs::directory_iterator it(dir.empty() ? fs::path(".") : dir, ec), end; !ec && it != end; it.increment(ec)) {
+    // .NAME.tmp-<pid>-<random>
     const std::string name = it->path().filename().string();
-    if (name.compare(0, prefix.size(), prefix) != 0) continue;
-    const char* digits = name.c_str() + prefix.size();
+    const std::size_t tmp = name.rfind(".tmp-");
+    if (name.empty() || name[0] != '.' || tmp == std::string::npos || tmp < 2) continue;
+    const char* digits = name.c_str() + tmp + 5;
     char* after = nullptr;
     errno = 0;
     const long pid = std::strtol(digits, &after, 10);
     if (after == digits || *after != '-' || errno == ERANGE || pid <= 0 || pid == ::getpid()) continue;
+    if (!of_target(name.substr(1, tmp - 1))) continue;
     // Only a process that no longer exists: kill(pid, 0) fails with ESRCH. A live one (or one we
     // may not signal, EPERM) may still be writing.
     if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
     std::error_code remove_ec;
     fs::remove(it->path(), remove_ec);
   }
+}
+
+void removeStaleTemporaries(const fs::path& target) noexcept {
+  const std::string target_name = target.filename().string();
+  removeStaleTemporaries(directoryOf(target), [&](const std::string& name) { return name == target_name; });
 }
 
 fs::path temporaryPathFor(const fs::path& target) {
@@ -97,6 +105,7 @@ fs::path AtomicFileSet::stage(const fs::path& target) {
     throw InputError(target.string(), "", "output directory " + dir.string() + " does not exist");
   }
   if (fs::is_directory(target, ec)) throw InputError(target.string(), "", "is a directory");
+  testSignalPoint();
   removeStaleTemporaries(target);
   Entry entry{target, temporaryPathFor(target), -1};
   entry.slot = pending_temporaries::add(entry.temporary.string());  // a signal removes it (interrupt.h)
@@ -121,21 +130,43 @@ void AtomicFileSet::write(const fs::path& target, std::string_view bytes) {
 
 void AtomicFileSet::commit() {
   if (committed_) return;
+  // A file renamed to a name that did not exist before stays registered (under its final name)
+  // until the last rename: an interrupt, or a failed rename, before then removes it again, so the
+  // folder is left as it was. A file that replaced another cannot be undone and is released.
+  std::vector<std::size_t> fresh;
+  auto release = [&] {
+    for (std::size_t j : fresh) pending_temporaries::remove(entries_[j].slot), entries_[j].slot = -1;
+  };
   for (std::size_t i = 0; i < entries_.size(); ++i) {
+    testSignalPoint();
+    Entry& entry = entries_[i];
     std::error_code ec;
-    fs::rename(entries_[i].temporary, entries_[i].target, ec);
-    if (!ec) pending_temporaries::remove(entries_[i].slot), entries_[i].slot = -1;
+    const bool existed = fs::exists(fs::symlink_status(entry.target, ec));
+    fs::rename(entry.temporary, entry.target, ec);
     if (ec) {
-      std::string message = entries_[i].target.string() + ": cannot move the finished file into place: " +
-                            ec.message();
-      // Files before i are in place already; drop the rest so no temporaries are left behind.
+      std::string message = entry.target.string() + ": cannot move the finished file into place: " + ec.message();
+      for (std::size_t j : fresh) {
+        std::error_code remove_ec;
+        fs::remove(entries_[j].target, remove_ec);
+      }
+      release();
+      // The rest are still temporaries: discard them.
       entries_.erase(entries_.begin(), entries_.begin() + static_cast<std::ptrdiff_t>(i));
       discard();
       throw RuntimeError(message);
     }
+    if (!existed && i + 1 < entries_.size()) {
+      entry.slot = pending_temporaries::replace(entry.slot, entry.target.string());
+      fresh.push_back(i);
+    } else {
+      pending_temporaries::remove(entry.slot);
+      entry.slot = -1;
+    }
   }
+  release();
   entries_.clear();
   committed_ = true;
+  testSignalPoint();
 }
 
 void AtomicFileSet::discard() noexcept {

@@ -7,6 +7,8 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -65,5 +67,8 @@ std::filesystem::path temporaryPathFor(const std::filesystem::path& target);
 // Removes the temporaries of `target` (.NAME.tmp-<pid>-…) that processes no longer alive left
 // behind (killed by SIGKILL, or a crash). stage() calls it. Never throws.
 void removeStaleTemporaries(const std::filesystem::path& target) noexcept;
+// The same for every target in `dir` whose file name `of_target` accepts.
+void removeStaleTemporaries(const std::filesystem::path& dir,
+                            const std::function<bool(const std::string&)>& of_target) noexcept;
 
 }  // namespace eik

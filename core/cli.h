@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "core/error.h"
+#include "core/paths.h"
 
 namespace eik {
 
@@ -23,6 +24,13 @@ inline bool parseCommandLine(CLI::App& app, int argc, char** argv) {
     throw InputError(std::string("command line: ") + e.what() + " (see " + app.get_name() + " --help)");
   }
   return true;
+}
+
+// --allow-outside-paths, which every program has (docs/programs.md, "Paths inside files").
+inline void addOutsidePathsFlag(CLI::App& app) {
+  app.add_flag_callback("--allow-outside-paths", [] { allowPathsOutsideFolder(true); },
+                        "follow paths inside the input files (a NRRD's data file, a manifest's fields, a scene's "
+                        "volumes and environment, glTF URIs) that leave the folder of the file naming them");
 }
 
 }  // namespace eik

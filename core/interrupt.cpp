@@ -5,7 +5,10 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <utility>
 
 namespace eik {
 
@@ -63,6 +66,12 @@ void unlinkAll() noexcept {
     if (slot.state.load(std::memory_order_acquire) == kReady) ::unlink(slot.path);
 }
 
+int replace(int slot, const std::string& path) noexcept {
+  const int added = add(path);
+  remove(slot);
+  return added;
+}
+
 int count() noexcept {
   int n = 0;
   for (const Slot& slot : g_slots) n += slot.state.load(std::memory_order_acquire) == kReady ? 1 : 0;
@@ -70,6 +79,20 @@ int count() noexcept {
 }
 
 }  // namespace pending_temporaries
+
+void testSignalPoint() noexcept {
+  // Parsed once; "SIG@N".
+  static const std::pair<int, long> target = [] {
+    const char* text = std::getenv("EIKONAL_TEST_SIGNAL_AT");
+    int signal_number = 0;
+    long n = 0;
+    if (text == nullptr || std::sscanf(text, "%d@%ld", &signal_number, &n) != 2 || n < 1) return std::pair<int, long>{0, 0};
+    return std::pair<int, long>{signal_number, n};
+  }();
+  if (target.first == 0) return;
+  static std::atomic<long> calls{0};
+  if (++calls == target.second) ::raise(target.first);
+}
 
 void installInterruptHandlers(const char* program) {
   g_program = program;

@@ -305,6 +305,7 @@ std::string headerText(const NrrdHeader& header, const NrrdWriteOptions& options
   text += "endian: little\n";
   text += options.gzip ? "encoding: gzip\n" : "encoding: raw\n";
   text += "space origin: " + formatVector(header.origin) + "\n";
+  if (!header.generation.empty()) text += "eikonal_generation:=" + header.generation + "\n";
   if (!data_file.empty()) text += "data file: " + data_file + "\n";
   return text;
 }

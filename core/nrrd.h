@@ -15,6 +15,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -29,6 +30,9 @@ struct NrrdHeader {
   glm::ivec3 sizes{0};                // voxels along x, y, z
   glm::dvec3 origin{0.0};             // world position of the centre of voxel (0,0,0)
   glm::dmat3 directions{1.0};         // column a = world step from voxel i to i+1 along axis a
+  // The key `eikonal_generation:=G`: the write of a volume this file belongs to (its manifest names
+  // the same G; docs/volume-format.md "Writing"). Empty when the file has no such key.
+  std::string generation;
 
   std::size_t voxelCount() const;
   std::size_t valueCount() const { return voxelCount() * static_cast<std::size_t>(components); }
@@ -42,7 +46,7 @@ struct NrrdImage {
   glm::dmat3 directions{1.0};
   std::vector<float> data;
 
-  NrrdHeader header() const { return {components, sizes, origin, directions}; }
+  NrrdHeader header() const { return {components, sizes, origin, directions, {}}; }
   std::size_t voxelCount() const { return header().voxelCount(); }
 };
 

@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/paths.h"
 #include "core/text.h"
 
 namespace eik::nrrd {
@@ -117,6 +118,7 @@ struct HeaderFields {
   fs::path path;
   std::map<std::string, FieldLine, std::less<>> lines;
   bool blank_line = false;  // the header ends with a blank line (attached data may follow)
+  std::string generation;   // the key eikonal_generation:=G (core/nrrd.h)
 
   const std::string* find(std::string_view name) const {
     auto it = lines.find(name);
@@ -155,7 +157,10 @@ HeaderFields readFields(const fs::path& path, std::FILE* file) {
            "line " + std::to_string(line_number) + ": " + inQuotes(line) +
                " is neither a field ('name: value'), a key ('key:=value') nor a comment ('#')");
     }
-    if (colon + 1 < line.size() && line[colon + 1] == '=') continue;  // key:=value pairs are carried by no one
+    if (colon + 1 < line.size() && line[colon + 1] == '=') {  // key:=value; ours is the generation
+      if (std::string_view(line).substr(0, colon) == "eikonal_generation") fields.generation = line.substr(colon + 2);
+      continue;
+    }
     std::string name = canonicalFieldName(std::string_view(line).substr(0, colon));
     std::string value(trim(std::string_view(line).substr(colon + 1)));
     if (fields.lines.count(name)) {
@@ -459,8 +464,7 @@ glm::dvec3 parseSpaceOrigin(const HeaderFields& fields, int dimension, const glm
 void parseDataFile(const HeaderFields& fields, ParsedHeader& parsed) {
   const fs::path& path = fields.path;
   if (const std::string* data_file = fields.find("data file")) {
-    fs::path data_path(*data_file);
-    if (data_path.is_relative()) data_path = path.parent_path() / data_path;
+    const fs::path data_path = resolveInsideFolder(path, "data file", *data_file);
     std::error_code ec;
     if (!fs::is_regular_file(data_path, ec)) fail(path, "data file", data_path.string() + ": not found");
     parsed.data_path = data_path;
@@ -505,6 +509,7 @@ ParsedHeader parseHeader(const fs::path& path, std::FILE* file) {
   parsed.header.directions = parseSpaceDirections(fields, parsed.dimension, flip);
   parsed.header.origin = parseSpaceOrigin(fields, parsed.dimension, parsed.header.directions, flip);
   parseDataFile(fields, parsed);
+  parsed.header.generation = fields.generation;
   parsed.line_skip = parseSkip(fields, "line skip");
   parsed.byte_skip = parseSkip(fields, "byte skip");
   return parsed;

@@ -51,8 +51,9 @@ TEST(ReceiverMap, RoundTripsThroughAVolume) {
   v.grid.bounds_max = glm::dvec3(1.0);
   v.addField("ior", 1);
   v.receivers.push_back(sampleMap());
-  writeVolume(v, dir / "r.vol.json");
-  EXPECT_TRUE(std::filesystem::exists(dir / "r.receiver-ground.nrrd"));
+  const std::string generation = writeVolume(v, dir / "r.vol.json");
+  const std::filesystem::path file = dir / ("r." + generation + ".receiver-ground.nrrd");
+  EXPECT_TRUE(std::filesystem::exists(file));
   const Volume back = readVolume(dir / "r.vol.json");
   ASSERT_EQ(back.receivers.size(), 1u);
   const ReceiverMap& m = back.receivers[0];
@@ -60,7 +61,8 @@ TEST(ReceiverMap, RoundTripsThroughAVolume) {
   EXPECT_EQ(m.irradiance, sampleMap().irradiance);
   EXPECT_NEAR(glm::length(m.v - sampleMap().v), 0.0, 1e-12);
   // The NRRD stands where the plane is: origin at texel (0, 0)'s centre, axes pitch·u, pitch·v.
-  const NrrdHeader h = readNrrdHeader(dir / "r.receiver-ground.nrrd");
+  const NrrdHeader h = readNrrdHeader(file);
+  EXPECT_EQ(h.generation, generation);
   EXPECT_NEAR(glm::length(h.origin - sampleMap().texelCenter(0, 0)), 0.0, 1e-9);
   EXPECT_NEAR(glm::length(h.directions[1] - 0.25 * sampleMap().v), 0.0, 1e-12);
   EXPECT_FALSE(readVolumeHeader(dir / "r.vol.json").receivers.empty());

@@ -11,6 +11,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/paths.h"
 #include "core/json_input.h"
 
 namespace eik {
@@ -112,8 +113,9 @@ void requireLightPower(const ObjectReader& r, const char* key, const glm::dvec3&
 
 }  // namespace
 
-std::filesystem::path Scene::resolve(const std::string& relative) const {
-  std::filesystem::path p(relative);
+std::filesystem::path Scene::resolve(const std::string& key, const std::string& named) const {
+  if (!file.empty()) return resolveInsideFolder(file, key, named);
+  std::filesystem::path p(named);
   return p.is_absolute() ? p : base_dir / p;
 }
 
@@ -231,6 +233,7 @@ Scene readScene(const std::filesystem::path& file) {
   const json j = parseJsonInput(text.str(), file.string());
   Scene scene = sceneFromJson(j, file.string());
   scene.base_dir = std::filesystem::absolute(file).parent_path();
+  scene.file = file;
   return scene;
 }
 

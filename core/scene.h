@@ -65,9 +65,12 @@ struct Scene {
   std::vector<SceneObjectSpec> objects;
   SceneRenderSpec render;
   std::filesystem::path base_dir;      // directory the scene was read from (for relative paths)
+  std::filesystem::path file;          // the SCENE.json it was read from (empty when built in memory)
 
-  // Absolute path of an object's volume or the environment file.
-  std::filesystem::path resolve(const std::string& relative) const;
+  // The path of an object's volume or the environment file, `named` as the scene's `key` names it.
+  // For a scene read from a file it must lie inside that file's folder (core/paths.h): otherwise
+  // InputError naming the key.
+  std::filesystem::path resolve(const std::string& key, const std::string& named) const;
 };
 
 // Parses and validates; `source` names the file in messages ("scene.json: lights[0].direction: ...").

@@ -2,19 +2,26 @@
 // `NAME.FIELD.nrrd` (or `NAME.FIELD.nhdr` + `NAME.FIELD.raw.gz` when detached), written atomically.
 #include "core/volume.h"
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <mutex>
+#include <random>
 #include <sstream>
 #include <system_error>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "core/json_input.h"
 #include "core/limits.h"
+#include "core/paths.h"
 #include "core/nrrd.h"
 
 namespace eik {
@@ -25,7 +32,7 @@ namespace {
 constexpr std::string_view kFormat = "eikonal-volume";
 constexpr int kVersion = 1;
 // Manifest keys writeVolume owns; metadata cannot overwrite them.
-constexpr std::string_view kReservedKeys[] = {"format",     "version", "dims",     "bounds_min",
+constexpr std::string_view kReservedKeys[] = {"format", "version", "generation", "dims",     "bounds_min",
                                              "bounds_max", "fields",  "receivers"};
 
 bool isReserved(std::string_view key) {
@@ -57,6 +64,103 @@ std::string manifestStem(const fs::path& manifest) {
 }
 
 
+// ---------------------------------------------------------------------------------------------
+// Generations (docs/volume-format.md "Writing")
+
+// The manifest a write replaces: its generation and the files it names that belong to this stem
+// (plain names in its folder starting with "STEM."; with a detached header's data files).
+struct PreviousWrite {
+  std::string generation;
+  std::vector<fs::path> files;
+};
+
+PreviousWrite previousWrite(const fs::path& manifest, const std::string& stem) {
+  PreviousWrite previous;
+  std::error_code ec;
+  const auto size = fs::file_size(manifest, ec);
+  if (ec || size > (std::uintmax_t{16} << 20)) return previous;  // none, or not a manifest of ours
+  try {
+    std::ifstream in(manifest, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    const nlohmann::json root = parseJsonInput(text.str(), manifest.string());
+    if (!root.is_object()) return previous;
+    if (auto g = root.find("generation"); g != root.end() && g->is_string()) previous.generation = g->get<std::string>();
+    std::vector<std::string> names;
+    if (auto fields = root.find("fields"); fields != root.end() && fields->is_object())
+      for (const auto& [unused, spec] : fields->items())
+        if (spec.is_object() && spec.contains("file") && spec["file"].is_string()) names.push_back(spec["file"]);
+    if (auto receivers = root.find("receivers"); receivers != root.end() && receivers->is_array())
+      for (const auto& spec : *receivers)
+        if (spec.is_object() && spec.contains("file") && spec["file"].is_string()) names.push_back(spec["file"]);
+    const fs::path dir = manifest.parent_path();
+    for (const std::string& name : names) {
+      if (name.find('/') != std::string::npos || name.rfind(stem + ".", 0) != 0) continue;
+      previous.files.push_back(dir / name);
+      if (fs::path(name).extension() == ".nhdr") {
+        previous.files.push_back(detachedDataPath(dir / name, false));
+        previous.files.push_back(detachedDataPath(dir / name, true));
+      }
+    }
+  } catch (const std::exception&) {
+    // Not a manifest we can read: nothing of it is removed.
+  }
+  return previous;
+}
+
+// A generation for a new write: random, and not the one being replaced.
+std::string newGeneration(const std::string& previous) {
+  static std::mt19937_64 random = [] {
+    std::random_device device;
+    return std::mt19937_64((static_cast<std::uint64_t>(device()) << 32) ^ device() ^
+                           static_cast<std::uint64_t>(::getpid()));
+  }();
+  static std::mutex mutex;
+  const std::lock_guard<std::mutex> lock(mutex);
+  for (;;) {
+    char text[9];
+    std::snprintf(text, sizeof text, "%08x", static_cast<unsigned>(random() & 0xffffffffu));
+    if (previous != text) return text;
+  }
+}
+
+// Does `name` belong to a generation of `stem` other than `generation`:
+// "STEM.<8 hex>.<field or receiver-NAME>.<nrrd|nhdr|raw|raw.gz>"?
+bool isOtherGenerationFile(const std::string& name, const std::string& stem, const std::string& generation) {
+  if (name.size() < stem.size() + 11 || name.compare(0, stem.size() + 1, stem + ".") != 0) return false;
+  const std::string g = name.substr(stem.size() + 1, 8);
+  if (!isValidGeneration(g) || g == generation || name[stem.size() + 9] != '.') return false;
+  std::string rest = name.substr(stem.size() + 10);
+  for (std::string_view extension : {".raw.gz", ".nrrd", ".nhdr", ".raw"}) {
+    if (rest.size() > extension.size() && rest.compare(rest.size() - extension.size(), extension.size(), extension) == 0) {
+      return isValidFieldName(rest.substr(0, rest.size() - extension.size()));
+    }
+  }
+  return false;
+}
+
+// After the switch to `generation`: removes what the previous manifest named and no longer is,
+// the files of any other generation of this stem (a write killed before its switch leaves its
+// files under their final names, unnamed by any manifest), and such writes' temporaries.
+void removeSupersededFiles(const fs::path& dir, const std::string& stem, const std::string& generation,
+                           const std::vector<fs::path>& previous, const std::vector<fs::path>& written) {
+  std::error_code ec;
+  for (const fs::path& file : previous) {
+    if (std::find(written.begin(), written.end(), file) != written.end() || !fs::exists(file, ec)) continue;
+    testSignalPoint();
+    fs::remove(file, ec);
+  }
+  const fs::path folder = dir.empty() ? fs::path(".") : dir;
+  std::vector<fs::path> others;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec))
+    if (isOtherGenerationFile(it->path().filename().string(), stem, generation)) others.push_back(it->path());
+  for (const fs::path& file : others) {
+    testSignalPoint();
+    fs::remove(file, ec);
+  }
+  removeStaleTemporaries(folder, [&](const std::string& name) { return isOtherGenerationFile(name, stem, generation); });
+}
+
 NrrdHeader nrrdHeaderFor(const GridSpec& grid, int components) {
   NrrdHeader header;
   header.components = components;
@@ -78,6 +182,7 @@ class ManifestReader {
     nlohmann::json root = parse();
     Volume volume;
     checkFormat(root);
+    readGeneration(root);
     volume.grid.dims = dims(root);
     volume.grid.bounds_min = numberTriple(root, "bounds_min");
     volume.grid.bounds_max = numberTriple(root, "bounds_max");
@@ -109,6 +214,7 @@ class ManifestReader {
         throw InputError(name_, "fields." + name, "a field name may hold only letters, digits, '_' and '-'");
       Entry entry{name, fieldFile(name, spec), {}};
       entry.header = fieldHeader(name, spec, entry.file, volume.grid);
+      checkGeneration("fields." + name, entry.file, entry.header);
       total_bytes += fieldBytes(entry.header.sizes, entry.header.components);
       entries.push_back(std::move(entry));
     }
@@ -143,8 +249,7 @@ class ManifestReader {
       const std::string key = "receivers[" + std::to_string(i) + "]";
       std::string file;
       ReceiverMap map = receiverFromJson((*receivers)[i], name_, key, file);
-      fs::path path(file);
-      if (path.is_relative()) path = manifest_.parent_path() / path;
+      const fs::path path = resolveInsideFolder(manifest_, key + ".file", file);
       std::error_code ec;
       if (!fs::is_regular_file(path, ec)) throw InputError(name_, key + ".file", path.string() + ": not found");
       NrrdHeader header;
@@ -154,6 +259,7 @@ class ManifestReader {
         throw InputError(name_ + ": " + key + ": " + e.what());
       }
       checkReceiverHeader(map, header, name_, key, path.string());
+      checkGeneration(key, path, header);
       if (with_data) {
         checkMemoryLimit(name_, key, fieldBytes(header.sizes, header.components));
         try {
@@ -167,6 +273,29 @@ class ManifestReader {
   }
 
  private:
+  // "generation": the write this manifest belongs to (writeVolume). Optional: hand-written and
+  // older manifests have none, and their files are then not checked.
+  void readGeneration(const nlohmann::json& root) {
+    auto generation = root.find("generation");
+    if (generation == root.end()) return;
+    if (!generation->is_string() || !isValidGeneration(generation->get<std::string>()))
+      throw InputError(name_, "generation", "expected 1 to 32 lowercase hex digits, got " + generation->dump().substr(0, 40));
+    generation_ = generation->get<std::string>();
+  }
+
+  // Every file of a manifest with a generation must carry the same one: anything else is a set
+  // mixed by an interrupted or concurrent write of other tools (ours never leave one).
+  void checkGeneration(const std::string& key, const fs::path& file, const NrrdHeader& header) const {
+    if (generation_.empty() || header.generation == generation_) return;
+    throw InputError(name_, key,
+                     file.filename().string() + " belongs to " +
+                         (header.generation.empty()                   ? std::string("no generation")
+                          : isValidGeneration(header.generation) ? "generation " + header.generation
+                                                                 : std::string("a malformed generation")) +
+                         ", the manifest to generation " + generation_ +
+                         " (files of different writes mixed; write the volume again)");
+  }
+
   nlohmann::json parse() {
     std::error_code ec;
     if (fs::is_directory(manifest_, ec)) throw InputError(name_, "", "is a directory, not a volume manifest");
@@ -246,8 +375,8 @@ class ManifestReader {
     if (!file->is_string() || file->get<std::string>().empty()) {
       throw InputError(name_, key + ".file", file->dump() + " is not a file name");
     }
-    fs::path path(file->get<std::string>());
-    if (path.is_relative()) path = manifest_.parent_path() / path;  // relative to the manifest
+    // relative to the manifest, and inside its folder (core/paths.h)
+    const fs::path path = resolveInsideFolder(manifest_, key + ".file", file->get<std::string>());
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) throw InputError(name_, key + ".file", path.string() + ": not found");
     return path;
@@ -331,9 +460,17 @@ class ManifestReader {
 
   fs::path manifest_;
   std::string name_;
+  std::string generation_;
 };
 
 }  // namespace
+
+bool isValidGeneration(const std::string& generation) {
+  if (generation.empty() || generation.size() > 32) return false;
+  for (char c : generation)
+    if (!((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'))) return false;
+  return true;
+}
 
 bool isValidFieldName(const std::string& name) {
   if (name.empty()) return false;
@@ -409,7 +546,7 @@ Volume readVolume(const fs::path& manifest) { return ManifestReader(manifest).re
 
 Volume readVolumeHeader(const fs::path& manifest) { return ManifestReader(manifest).read(false); }
 
-void writeVolume(const Volume& volume, const fs::path& manifest, const VolumeWriteOptions& options) {
+std::string writeVolume(const Volume& volume, const fs::path& manifest, const VolumeWriteOptions& options) {
   const std::string name = manifest.string();
   const GridSpec& grid = volume.grid;
   for (int a = 0; a < 3; ++a) {
@@ -429,7 +566,19 @@ void writeVolume(const Volume& volume, const fs::path& manifest, const VolumeWri
 
   const std::string stem = manifestStem(manifest);
   const fs::path dir = manifest.parent_path();
+  // What the manifest being replaced names, read before it is replaced (removed after the switch).
+  const PreviousWrite previous = previousWrite(manifest, stem);
+  const std::string generation = newGeneration(previous.generation);
   AtomicFileSet files;  // removes every temporary if anything below throws
+  std::vector<fs::path> written;
+  const std::string prefix = stem + "." + generation + ".";
+  const char* extension = options.detached ? ".nhdr" : ".nrrd";
+  auto stage = [&](const fs::path& file, NrrdHeader header, std::span<const float> data) {
+    header.generation = generation;
+    stageNrrd(files, file, header, data, {options.gzip, options.detached});
+    written.push_back(file);
+    if (options.detached) written.push_back(detachedDataPath(file, options.gzip));
+  };
 
   nlohmann::ordered_json table = nlohmann::ordered_json::object();
   for (const auto& [field_name, field] : volume.fields) {
@@ -442,8 +591,8 @@ void writeVolume(const Volume& volume, const fs::path& manifest, const VolumeWri
                          " components, but the '" + field_name + "' field has " + std::to_string(known) +
                          " (docs/volume-format.md)");
     }
-    fs::path file = dir / (stem + "." + field_name + (options.detached ? ".nhdr" : ".nrrd"));
-    stageNrrd(files, file, nrrdHeaderFor(grid, field.components), field.data, {options.gzip, options.detached});
+    const fs::path file = dir / (prefix + field_name + extension);
+    stage(file, nrrdHeaderFor(grid, field.components), field.data);
     table[field_name] = {{"file", file.filename().string()}, {"components", field.components}};
   }
 
@@ -454,14 +603,15 @@ void writeVolume(const Volume& volume, const fs::path& manifest, const VolumeWri
     if (map.irradiance.size() != map.texelCount() * 3)
       throw RuntimeError(name + ": receivers." + map.name + ": " + std::to_string(map.irradiance.size()) +
                          " values for " + std::to_string(map.texelCount()) + " RGB texels");
-    fs::path file = dir / (stem + ".receiver-" + map.name + (options.detached ? ".nhdr" : ".nrrd"));
-    stageNrrd(files, file, map.nrrdHeader(), map.irradiance, {options.gzip, options.detached});
+    const fs::path file = dir / (prefix + "receiver-" + map.name + extension);
+    stage(file, map.nrrdHeader(), map.irradiance);
     receivers.push_back(nlohmann::ordered_json::parse(map.toJson(file.filename().string()).dump()));
   }
 
   nlohmann::ordered_json json = nlohmann::ordered_json::object();
   json["format"] = kFormat;
   json["version"] = kVersion;
+  json["generation"] = generation;
   json["dims"] = {grid.dims.x, grid.dims.y, grid.dims.z};
   json["bounds_min"] = {grid.bounds_min.x, grid.bounds_min.y, grid.bounds_min.z};
   json["bounds_max"] = {grid.bounds_max.x, grid.bounds_max.y, grid.bounds_max.z};
@@ -472,8 +622,11 @@ void writeVolume(const Volume& volume, const fs::path& manifest, const VolumeWri
       if (!isReserved(key)) json[key] = nlohmann::ordered_json::parse(value.dump());
     }
   }
-  files.write(manifest, json.dump(2) + "\n");  // staged last: renamed into place after every field
+  // Staged last, so renamed into place after every file it names: the switch to generation G.
+  files.write(manifest, json.dump(2) + "\n");
   files.commit();
+  removeSupersededFiles(dir, stem, generation, previous.files, written);
+  return generation;
 }
 
 }  // namespace eik

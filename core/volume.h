@@ -67,12 +67,18 @@ Volume readVolume(const std::filesystem::path& manifest);
 // A field or receiver name the format allows: letters, digits, '_' and '-' (it becomes part of a
 // file name). Readers refuse other names, the writer never writes them.
 bool isValidFieldName(const std::string& name);
+// The generation of a write: 8 lowercase hex digits (writeVolume); readers accept 1 to 32.
+bool isValidGeneration(const std::string& generation);
 // Reads only the manifest and the headers (grid, field table); no voxel data.
 Volume readVolumeHeader(const std::filesystem::path& manifest);
 
-// Writes `OUT.vol.json` and one NRRD per field beside it (`OUT.FIELD.nrrd`), atomically: all files
-// go to temporary names first and are renamed into place only when everything succeeded.
-void writeVolume(const Volume& volume, const std::filesystem::path& manifest,
-                 const VolumeWriteOptions& options = {});
+// Writes `OUT.vol.json` and one NRRD per field and receiver beside it, all or nothing
+// (docs/volume-format.md "Writing"): every write is a new generation G (8 hex digits); its files are
+// `OUT.G.FIELD.nrrd` and `OUT.G.receiver-NAME.nrrd`, each carrying `eikonal_generation:=G`, and
+// the manifest, which names G, is renamed into place last: that rename is the switch from the old
+// volume to the new. The files of other generations of OUT (the previous write's, or those an
+// interrupted write left) are removed after it. Returns G.
+std::string writeVolume(const Volume& volume, const std::filesystem::path& manifest,
+                        const VolumeWriteOptions& options = {});
 
 }  // namespace eik

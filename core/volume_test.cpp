@@ -7,6 +7,9 @@
 #include <random>
 #include <string>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include "core/error.h"
@@ -60,6 +63,12 @@ json writeSample(const TempDir& dir, const VolumeWriteOptions& options = {}) {
 }
 
 void rewriteManifest(const TempDir& dir, const json& manifest) { writeFile(dir / "scene.vol.json", manifest.dump(2)); }
+
+// The file the manifest names for a field ("scene.<generation>.sigma_a.nrrd").
+fs::path fieldPath(const fs::path& manifest, const std::string& name) {
+  return manifest.parent_path() / json::parse(readFile(manifest)).at("fields").at(name).at("file").get<std::string>();
+}
+fs::path fieldPath(const TempDir& dir, const std::string& name) { return fieldPath(dir / "scene.vol.json", name); }
 
 std::string manifestError(const TempDir& dir) {
   return inputErrorOf([&] { readVolume(dir / "scene.vol.json"); });
@@ -116,24 +125,32 @@ TEST_P(VolumeRoundTrip, IsBitExact) {
   EXPECT_FALSE(back.metadata.contains("format"));
   EXPECT_FALSE(back.metadata.contains("fields"));
 
-  // Every entry is a field file or the manifest: no temporaries.
+  // Every entry is a field file of this write's generation or the manifest: no temporaries.
+  const std::string generation = json::parse(readFile(dir / "scene.vol.json")).at("generation");
+  EXPECT_TRUE(isValidGeneration(generation) && generation.size() == 8) << generation;
   std::vector<std::string> expected = {"scene.vol.json"};
   for (const auto& [name, unused] : volume.fields) {
+    const std::string stem = "scene." + generation + "." + name;
     if (GetParam().detached) {
-      expected.push_back("scene." + name + ".nhdr");
-      expected.push_back("scene." + name + (GetParam().gzip ? ".raw.gz" : ".raw"));
+      expected.push_back(stem + ".nhdr");
+      expected.push_back(stem + (GetParam().gzip ? ".raw.gz" : ".raw"));
     } else {
-      expected.push_back("scene." + name + ".nrrd");
+      expected.push_back(stem + ".nrrd");
     }
+    EXPECT_EQ(readNrrdHeader(fieldPath(dir, name)).generation, generation) << name;
   }
   std::sort(expected.begin(), expected.end());
   EXPECT_EQ(dir.entries(), expected);
 
-  // Writing the read-back volume again reproduces the manifest.
+  // Writing the read-back volume again reproduces the manifest, but for the new generation.
   std::string first = readFile(dir / "scene.vol.json");
   TempDir again;
-  writeVolume(back, again / "scene.vol.json", GetParam());
-  EXPECT_EQ(readFile(again / "scene.vol.json"), first);
+  const std::string second_generation = writeVolume(back, again / "scene.vol.json", GetParam());
+  EXPECT_NE(second_generation, generation);
+  std::string second = readFile(again / "scene.vol.json");
+  for (std::size_t at; (at = second.find(second_generation)) != std::string::npos;)
+    second.replace(at, second_generation.size(), generation);
+  EXPECT_EQ(second, first);
 }
 
 INSTANTIATE_TEST_SUITE_P(Encodings, VolumeRoundTrip,
@@ -152,14 +169,16 @@ TEST(Volume, ManifestLayout) {
   EXPECT_EQ(manifest.at("dims"), json({8, 6, 4}));
   EXPECT_EQ(manifest.at("bounds_min"), json({-1.0, -0.75, 0.1}));
   EXPECT_EQ(manifest.at("bounds_max"), json({1.0, 0.75, 0.9}));
-  EXPECT_EQ(manifest.at("fields").at("ior"), json({{"file", "scene.ior.nrrd"}, {"components", 1}}));
-  EXPECT_EQ(manifest.at("fields").at("sigma_a"), json({{"file", "scene.sigma_a.nrrd"}, {"components", 3}}));
+  const std::string g = manifest.at("generation");
+  EXPECT_EQ(manifest.at("fields").at("ior"), json({{"file", "scene." + g + ".ior.nrrd"}, {"components", 1}}));
+  EXPECT_EQ(manifest.at("fields").at("sigma_a"), json({{"file", "scene." + g + ".sigma_a.nrrd"}, {"components", 3}}));
   EXPECT_EQ(manifest.at("light").at("type"), "directional");
   std::string text = readFile(dir / "scene.vol.json");
-  EXPECT_EQ(text.rfind("{\n  \"format\": \"eikonal-volume\",\n  \"version\": 1,", 0), 0u) << text;
+  EXPECT_EQ(text.rfind("{\n  \"format\": \"eikonal-volume\",\n  \"version\": 1,\n  \"generation\": \"" + g + "\",", 0), 0u)
+      << text;
 
   // The NRRD sits on the grid: origin = centre of voxel 0, directions = diag(voxel size).
-  NrrdHeader header = readNrrdHeader(dir / "scene.sigma_a.nrrd");
+  NrrdHeader header = readNrrdHeader(fieldPath(dir, "sigma_a"));
   EXPECT_EQ(header.components, 3);
   EXPECT_EQ(header.sizes, glm::ivec3(8, 6, 4));
   EXPECT_DOUBLE_EQ(header.origin.x, -1.0 + 0.125);
@@ -185,7 +204,7 @@ TEST(Volume, HeaderOnlyReadSkipsTheData) {
 TEST(Volume, ManifestNameWithoutVolJson) {
   TempDir dir;
   writeVolume(sampleVolume(), dir / "plain.json");
-  EXPECT_TRUE(fs::exists(dir / "plain.ior.nrrd"));
+  EXPECT_TRUE(fs::exists(fieldPath(dir / "plain.json", "ior")));
   expectSameVolume(sampleVolume(), readVolume(dir / "plain.json"));
 }
 
@@ -195,10 +214,11 @@ TEST(Volume, ManifestNameWithoutVolJson) {
 TEST(VolumeMalformed, MissingFieldFile) {
   TempDir dir;
   writeSample(dir);
-  fs::remove(dir / "scene.sigma_a.nrrd");
+  const fs::path sigma_a = fieldPath(dir, "sigma_a");
+  fs::remove(sigma_a);
   std::string message = manifestError(dir);
   EXPECT_CONTAINS(message, (dir / "scene.vol.json").string() + ": fields.sigma_a.file: ");
-  EXPECT_CONTAINS(message, (dir / "scene.sigma_a.nrrd").string() + ": not found");
+  EXPECT_CONTAINS(message, sigma_a.string() + ": not found");
   EXPECT_THROW(readVolumeHeader(dir / "scene.vol.json"), InputError);
 }
 
@@ -248,11 +268,11 @@ TEST(VolumeMalformed, FieldWithWrongComponentCount) {
   rewriteManifest(dir, manifest);
   std::string message = manifestError(dir);
   EXPECT_CONTAINS(message, "scene.vol.json: fields.custom_mask.components: 2, but ");
-  EXPECT_CONTAINS(message, "scene.custom_mask.nrrd has 1 components");
+  EXPECT_CONTAINS(message, fieldPath(dir, "custom_mask").filename().string() + " has 1 components");
 
   // A known field whose NRRD has the wrong count, with no count in the manifest.
   manifest = writeSample(dir);
-  manifest["fields"]["ior"] = {{"file", "scene.sigma_a.nrrd"}};
+  manifest["fields"]["ior"] = {{"file", manifest["fields"]["sigma_a"]["file"]}};
   rewriteManifest(dir, manifest);
   EXPECT_CONTAINS(manifestError(dir), "scene.vol.json: fields.ior: ");
 }
@@ -334,7 +354,7 @@ TEST(VolumeMalformed, JsonSyntaxAndStructure) {
 TEST(VolumeMalformed, NrrdErrorsNameTheManifestFieldAndFile) {
   TempDir dir;
   writeSample(dir, {false, false});
-  fs::path nrrd = dir / "scene.scatter.nrrd";
+  fs::path nrrd = fieldPath(dir, "scatter");
   std::string bytes = readFile(nrrd);
   writeFile(nrrd, bytes.substr(0, bytes.size() - 8));
   std::string message = manifestError(dir);
@@ -363,7 +383,7 @@ TEST(VolumeWrite, FailureMidWriteLeavesNoFiles) {
     writeVolume(volume, dir / "scene.vol.json");
     FAIL() << "expected RuntimeError";
   } catch (const RuntimeError& e) {
-    EXPECT_CONTAINS(e.what(), "scene.sigma_a.nrrd: data: NaN");
+    EXPECT_CONTAINS(e.what(), ".sigma_a.nrrd: data: NaN");
   }
   EXPECT_TRUE(dir.entries().empty()) << ::testing::PrintToString(dir.entries());
 }
@@ -373,7 +393,8 @@ TEST(VolumeWrite, FailedRewriteKeepsTheOldVolume) {
   writeSample(dir, {true, true});
   std::vector<std::string> before = dir.entries();
   std::string manifest = readFile(dir / "scene.vol.json");
-  std::string ior = readFile(dir / "scene.ior.raw.gz");
+  const fs::path ior_data = detachedDataPath(fieldPath(dir, "ior"), true);
+  std::string ior = readFile(ior_data);
 
   Volume volume = sampleVolume();
   volume.fields.at("ior").data.assign(volume.fields.at("ior").data.size(), 1.5f);
@@ -381,7 +402,7 @@ TEST(VolumeWrite, FailedRewriteKeepsTheOldVolume) {
   EXPECT_THROW(writeVolume(volume, dir / "scene.vol.json", {true, true}), RuntimeError);
   EXPECT_EQ(dir.entries(), before);
   EXPECT_EQ(readFile(dir / "scene.vol.json"), manifest);
-  EXPECT_EQ(readFile(dir / "scene.ior.raw.gz"), ior);
+  EXPECT_EQ(readFile(ior_data), ior);
 }
 
 TEST(VolumeWrite, UnwritableDestinationLeavesNoFiles) {
@@ -408,6 +429,96 @@ TEST(VolumeWrite, RejectsInconsistentVolumes) {
   volume.grid.bounds_max.x = volume.grid.bounds_min.x;
   EXPECT_THROW(writeVolume(volume, dir / "d.vol.json"), RuntimeError);
   EXPECT_TRUE(dir.entries().empty());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Generations (docs/volume-format.md "Writing"): all or nothing across files
+
+// A process id that no longer exists (a child that has exited and been reaped).
+pid_t deadPid() {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  return child;
+}
+
+TEST(VolumeGeneration, ARewriteLeavesOnlyTheNewGenerationAndKeepsOtherFiles) {
+  TempDir dir;
+  // An old set under the names writers used before generations, named by its manifest.
+  json manifest = writeSample(dir);
+  for (auto& [name, spec] : manifest["fields"].items()) {
+    const std::string legacy = "scene." + name + ".nrrd";
+    fs::rename(dir / spec["file"].get<std::string>(), dir / legacy);
+    spec["file"] = legacy;
+  }
+  manifest.erase("generation");
+  rewriteManifest(dir, manifest);
+  const Volume legacy = readVolume(dir / "scene.vol.json");  // no generation: not checked
+  // Files that are not the volume's: another volume's, notes, look-alikes.
+  writeFile(dir / "scene.notes.txt", "mine");
+  writeFile(dir / "scenery.0badcafe.ior.nrrd", "not this stem");
+  writeFile(dir / "scene.0badcafe.ior.nrrd.bak", "not a field file name");
+  writeFile(dir / "other.vol.json", "{}");
+
+  const std::string g1 = writeVolume(sampleVolume(), dir / "scene.vol.json");
+  std::vector<std::string> expected = {"other.vol.json", "scene.0badcafe.ior.nrrd.bak", "scene.notes.txt", "scene.vol.json",
+                                       "scenery.0badcafe.ior.nrrd"};
+  for (const auto& [name, unused] : sampleVolume().fields) expected.push_back("scene." + g1 + "." + name + ".nrrd");
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(dir.entries(), expected);
+  expectSameVolume(legacy, readVolume(dir / "scene.vol.json"));
+
+  const std::string g2 = writeVolume(sampleVolume(), dir / "scene.vol.json", {true, true});
+  EXPECT_NE(g2, g1);
+  for (const std::string& name : dir.entries()) EXPECT_EQ(name.find(g1), std::string::npos) << name;
+  EXPECT_TRUE(fs::exists(dir / "scene.notes.txt"));
+  expectSameVolume(sampleVolume(), readVolume(dir / "scene.vol.json"));
+}
+
+TEST(VolumeGeneration, WhatAKilledWriteLeftIsRemovedByTheNext) {
+  TempDir dir;
+  writeSample(dir);
+  // A write killed before its switch: its files under final names, a temporary of its dead process.
+  const std::string dead = std::to_string(deadPid());
+  writeFile(dir / "scene.deadbeef.ior.nrrd", "renamed, never named by a manifest");
+  writeFile(dir / "scene.deadbeef.receiver-ground.nrrd", "likewise");
+  writeFile(dir / (".scene.deadbeef.sigma_a.nrrd.tmp-" + dead + "-0123456789abcdef"), "half written");
+  // A live process's temporary (this one's parent: alive) is not touched.
+  const std::string live = ".scene.feedf00d.ior.nrrd.tmp-" + std::to_string(::getppid()) + "-0123456789abcdef";
+  writeFile(dir / live, "still being written");
+  expectSameVolume(sampleVolume(), readVolume(dir / "scene.vol.json"));  // the set is not mixed by them
+
+  const std::string g = writeVolume(sampleVolume(), dir / "scene.vol.json");
+  for (const std::string& name : dir.entries()) {
+    if (name == live || name == "scene.vol.json") continue;
+    EXPECT_EQ(name.rfind("scene." + g + ".", 0), 0u) << name;
+  }
+  EXPECT_TRUE(fs::exists(dir / live));
+}
+
+TEST(VolumeGeneration, AFileOfAnotherWriteIsRefusedNamingTheFieldAndBothGenerations) {
+  TempDir dir, other;
+  json manifest = writeSample(dir);
+  const std::string g = manifest["generation"];
+  const std::string g_other = writeVolume(sampleVolume(), other / "scene.vol.json");
+  // The sigma_a file replaced by the other write's (as a tool copying files one by one might).
+  fs::copy_file(fieldPath(other / "scene.vol.json", "sigma_a"), fieldPath(dir, "sigma_a"),
+                fs::copy_options::overwrite_existing);
+  std::string message = manifestError(dir);
+  EXPECT_CONTAINS(message, (dir / "scene.vol.json").string() + ": fields.sigma_a: ");
+  EXPECT_CONTAINS(message, "belongs to generation " + g_other + ", the manifest to generation " + g);
+  // A file without a generation, in a manifest with one.
+  writeNrrd(fieldPath(dir, "sigma_a"), NrrdImage{3, {8, 6, 4}, {-0.875, -0.625, 0.2},
+                                                   glm::dmat3(0.25, 0, 0, 0, 0.25, 0, 0, 0, 0.2),
+                                                   std::vector<float>(8 * 6 * 4 * 3, 0.5f)});
+  EXPECT_CONTAINS(manifestError(dir), "belongs to no generation, the manifest to generation " + g);
+  // A malformed generation in the manifest.
+  for (const json& bad : {json("XYZ"), json(""), json(12), json(std::string(33, 'a'))}) {
+    manifest["generation"] = bad;
+    rewriteManifest(dir, manifest);
+    EXPECT_CONTAINS(manifestError(dir), "scene.vol.json: generation: expected 1 to 32 lowercase hex digits");
+  }
 }
 
 }  // namespace

@@ -124,6 +124,7 @@ int run(int argc, char** argv) {
       "  lightsim glass.vol.json -o glass.baked.vol.json --scene glass.scene.json --backend cpu\n"
       "  lightsim sphere.vol.json -o sphere.baked.vol.json --light directional:0,-1,0 --receiver 0,0,0:0,1,0\n"
       "Exit codes: 0 success, 1 runtime failure, 2 bad usage or bad input.");
+  addOutsidePathsFlag(app);
   if (!parseCommandLine(app, argc, argv)) return kExitOk;
 
   if (output.size() < 9 || output.substr(output.size() - 9) != ".vol.json")

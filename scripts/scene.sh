@@ -6,8 +6,9 @@
 #
 # Each scene is a folder assets/NAME/ with SCENE.json (what the viewer renders) and build.sh (the
 # voxelize and lightsim commands that make its volumes). A scene is built into DIR/NAME/ (default
-# DIR: build/scenes): SCENE.json is copied there, the volumes are written beside it, the
-# environment maps are copied to DIR/env/, and the render goes to DIR/NAME.png. Afterwards
+# DIR: build/scenes): SCENE.json is copied there, the volumes are written beside it, so is the
+# environment map it names (from assets/env/; a scene may name files in its own folder only, see
+# docs/programs.md "Paths inside files"), and the render goes to DIR/NAME.png. Afterwards
 #   build/viewer/viewer DIR/NAME/SCENE.json
 # opens the scene in a window. DIR/NAME/times.json records the image size, the renderer and the
 # voxelize, bake and render times.
@@ -66,8 +67,7 @@ if [[ " ${names[*]} " == *" amber_bunny "* ]] && [ ! -s "$assets/meshes/bunny.ob
   exit 2
 fi
 
-mkdir -p "$out/env"
-cp -u "$assets"/env/*.exr "$assets/env/LICENSE.md" "$out/env/"
+mkdir -p "$out"
 out=$(cd "$out" && pwd)
 
 # What build.sh files call. They run inside DIR/NAME/, with ASSETS (assets/) and SCENE_DIR
@@ -93,6 +93,11 @@ for name in "${names[@]}"; do
   dir="$out/$name"
   mkdir -p "$dir"
   cp "$assets/$name/SCENE.json" "$dir/SCENE.json"
+  env_map=$(sed -n 's/.*"environment": *{"file": *"\([^"]*\)".*/\1/p' "$dir/SCENE.json")
+  if [ -n "$env_map" ]; then
+    cp -u "$assets/env/$env_map" "$dir/$env_map"
+    cp -u "$assets/env/LICENSE.md" "$dir/LICENSE-environment.md"
+  fi
   echo "scene.sh: [$i/${#names[@]}] $name: voxelize and bake into $dir"
   rm -f "$dir/.times"
   (cd "$dir" && ASSETS=$assets SCENE_DIR=$assets/$name && source "$assets/$name/build.sh")

@@ -121,6 +121,7 @@ int run(int argc, char** argv) {
       "  viewer glass.baked.vol.json --render out.exr --env sky\n"
       "  viewer scene.json --bench 20 --size 512x512 --stats bench.json\n"
       "Exit codes: 0 success, 1 runtime failure, 2 bad usage or bad input.");
+  addOutsidePathsFlag(app);
   if (!parseCommandLine(app, argc, argv)) return kExitOk;
   const bool bench = app.count("--bench") > 0;
   const bool window_mode = output.empty() && !bench;

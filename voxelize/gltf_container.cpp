@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "core/json_input.h"
+#include "core/paths.h"
 #include "voxelize/gltf_diagnostics.h"
 
 namespace eik {
@@ -31,6 +32,21 @@ std::string decodeUri(const std::string& uri) {
     }
   }
   return out;
+}
+
+// Images are not decoded (voxelize reads no texture), but tinygltf opens external image files
+// before handing them to the (skipping) image loader: their URIs obey the folder rule too.
+void precheckImageUris(const std::string& file, const nlohmann::json& root, const std::filesystem::path& base_dir) {
+  auto images = root.find("images");
+  if (images == root.end() || !images->is_array()) return;
+  for (std::size_t i = 0; i < images->size(); ++i) {
+    const nlohmann::json& image = (*images)[i];
+    if (!image.is_object()) continue;  // tinygltf reports it
+    auto uri = image.find("uri");
+    if (uri == image.end() || !uri->is_string()) continue;
+    const std::string u = uri->get<std::string>();
+    if (u.rfind("data:", 0) != 0) resolveInsideFolder(base_dir, file, indexed("images", i) + ".uri", decodeUri(u));
+  }
 }
 
 }  // namespace
@@ -87,6 +103,7 @@ void precheckGltfJson(const std::string& file, const std::string& text, const st
                       const GlbParts* glb) {
   const nlohmann::json root = parseJsonInput(text, file, "json");
   if (!root.is_object()) throw InputError(file, "json", "the top level is not an object");
+  precheckImageUris(file, root, base_dir);
   auto buffers = root.find("buffers");
   if (buffers == root.end() || !buffers->is_array()) return;
   for (std::size_t i = 0; i < buffers->size(); ++i) {
@@ -111,7 +128,7 @@ void precheckGltfJson(const std::string& file, const std::string& text, const st
     if (!uri->is_string()) throw InputError(file, field + ".uri", "is not a string");
     const std::string u = uri->get<std::string>();
     if (u.rfind("data:", 0) == 0) continue;  // embedded; tinygltf decodes and checks it
-    const std::filesystem::path external = base_dir / decodeUri(u);
+    const std::filesystem::path external = resolveInsideFolder(base_dir, file, field + ".uri", decodeUri(u));
     std::error_code ec;
     if (!std::filesystem::is_regular_file(external, ec))
       throw InputError(file, field + ".uri", "external buffer file '" + external.string() + "' not found");

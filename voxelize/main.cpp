@@ -81,6 +81,7 @@ int run(int argc, char** argv) {
       "  voxelize glass.glb -o glass.vol.json --res 256\n"
       "  voxelize bunny.obj --material ior=1.55,sigma_a=0.2:0.6:1.4 -o bunny.vol.json\n"
       "Exit codes: 0 success, 1 runtime failure, 2 bad usage or bad input.");
+  addOutsidePathsFlag(app);
   if (!parseCommandLine(app, argc, argv)) return kExitOk;
   if (smooth->count() > 0) {
     if (app.count("--interfaces") > 0 && o.interfaces == "sharp")

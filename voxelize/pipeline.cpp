@@ -11,6 +11,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "core/scene.h"
 #include "core/stopwatch.h"
 #include "core/text.h"
@@ -260,6 +261,13 @@ fs::path writeOutputs(const Volume& volume, const std::vector<MeshScene>& scenes
   const SceneExport exported = exportScene(scenes, out, grid);
   if (scene_path.empty() && exported.from_gltf)
     scene_path = out.parent_path() / (out.filename().string().substr(0, out.filename().string().size() - 9) + ".scene.json");
+  // The scene names the volume by its manifest: it is written after it, and the previous run's is
+  // removed before, so an interrupted run leaves the new volume without a scene, never with the old one.
+  std::error_code ec;
+  if (!scene_path.empty() && fs::is_regular_file(scene_path, ec)) {
+    testSignalPoint();
+    fs::remove(scene_path, ec);
+  }
   writeVolume(volume, out, write);
   if (!scene_path.empty()) {
     writeScene(exported.scene, scene_path);
