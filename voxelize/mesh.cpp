@@ -1,6 +1,7 @@
 #include "voxelize/mesh.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <numeric>
@@ -162,6 +163,38 @@ void TriangleMesh::append(const TriangleMesh& other) {
 
 void TriangleMesh::flipWinding() {
   for (glm::uvec3& t : triangles) std::swap(t[1], t[2]);
+}
+
+TriangleMesh withoutEmptyOrRepeatedTriangles(const TriangleMesh& mesh, std::size_t* dropped) {
+  using Key = std::array<double, 9>;
+  // Each triangle's corners, rotated so the smallest position comes first (the cyclic order, and
+  // with it the orientation, kept); empty triangles have no key.
+  std::vector<std::pair<Key, std::uint32_t>> keys;
+  keys.reserve(mesh.triangles.size());
+  auto less = [](const glm::dvec3& a, const glm::dvec3& b) {
+    return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+  };
+  std::vector<char> keep(mesh.triangles.size(), 0);
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const glm::dvec3 c[3] = {mesh.corner(t, 0), mesh.corner(t, 1), mesh.corner(t, 2)};
+    if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) continue;
+    const int first = less(c[1], c[0]) ? (less(c[2], c[1]) ? 2 : 1) : (less(c[2], c[0]) ? 2 : 0);
+    Key key;
+    for (int i = 0; i < 3; ++i)
+      for (int a = 0; a < 3; ++a) key[static_cast<std::size_t>(3 * i + a)] = c[(first + i) % 3][a];
+    keys.emplace_back(key, static_cast<std::uint32_t>(t));
+  }
+  std::sort(keys.begin(), keys.end());
+  for (std::size_t i = 0; i < keys.size(); ++i)
+    if (i == 0 || keys[i].first != keys[i - 1].first) keep[keys[i].second] = 1;  // the first of equal keys
+  TriangleMesh out;
+  out.name = mesh.name;
+  out.material = mesh.material;
+  out.positions = mesh.positions;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    if (keep[t]) out.triangles.push_back(mesh.triangles[t]);
+  if (dropped) *dropped = mesh.triangles.size() - out.triangles.size();
+  return out;
 }
 
 }  // namespace eik

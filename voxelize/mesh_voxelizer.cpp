@@ -99,6 +99,11 @@ bool isOpenSurface(const TriangleMesh& mesh, const GridSpec& grid, const MeshVox
   return surface;
 }
 
+// voxelizeMesh after the input's validation and cleaning.
+static Region voxelizeCleanMesh(const TriangleMesh& mesh, const GridSpec& grid, const MeshVoxelizeOptions& options,
+                                ProgressFn progress, MeshVoxelizeStats& stats, const Stopwatch& clock,
+                                MeshVoxelizeStats* stats_out);
+
 Region voxelizeMesh(const TriangleMesh& mesh, const GridSpec& grid, const MeshVoxelizeOptions& options,
                     ProgressFn progress, MeshVoxelizeStats* stats_out) {
   const Stopwatch clock;
@@ -116,7 +121,16 @@ Region voxelizeMesh(const TriangleMesh& mesh, const GridSpec& grid, const MeshVo
   const glm::dvec3 h = grid.voxelSize();
   if (!(h.x > 0.0 && h.y > 0.0 && h.z > 0.0)) throw InputError(mesh.name, "grid", "bounds have no extent");
 
-  stats.topology = mesh.topology();
+  stats.topology = mesh.topology();  // reports the input's degenerate triangles too
+  std::size_t dropped = 0;
+  const TriangleMesh cleaned = withoutEmptyOrRepeatedTriangles(mesh, &dropped);
+  stats.dropped_triangles = dropped;
+  return voxelizeCleanMesh(cleaned, grid, options, progress, stats, clock, stats_out);
+}
+
+static Region voxelizeCleanMesh(const TriangleMesh& mesh, const GridSpec& grid, const MeshVoxelizeOptions& options,
+                                ProgressFn progress, MeshVoxelizeStats& stats, const Stopwatch& clock,
+                                MeshVoxelizeStats* stats_out) {
   const SheetMeasures sheets = measureSheets(mesh);
   stats.area = sheets.area;
   stats.signed_volume = mesh.signedVolume();

@@ -54,6 +54,7 @@ struct MeshVoxelizeStats {
   std::uint64_t rays_through_holes = 0;   // sub-rays whose crossings did not sum to 0
   std::uint64_t winding_voxels = 0;       // voxels decided by the generalized winding number
   std::uint64_t winding_evaluations = 0;
+  std::uint64_t dropped_triangles = 0;    // zero-area or repeated triangles (withoutEmptyOrRepeatedTriangles)
   double seconds = 0.0;
 };
 

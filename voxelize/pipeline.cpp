@@ -215,6 +215,7 @@ std::vector<Region> voxelizeObjects(const std::vector<Input>& inputs, const Grid
                                  {"decision", ms.decision},
                                  {"rays_through_holes", ms.rays_through_holes},
                                  {"winding_voxels", ms.winding_voxels},
+                                 {"dropped_triangles", ms.dropped_triangles},
                                  {"enclosed_volume", r.enclosed_volume},
                                  {"seconds", ms.seconds}});
         regions.push_back(std::move(r));
