@@ -9,7 +9,7 @@
 #   --seconds S  a campaign: each harness for S seconds (default 60), J processes at once (default 1);
 #                new inputs go to build-fuzz/corpus/NAME/ (the seeds stay as they are), crashes to
 #                build-fuzz/crashes/NAME/
-#   NAME         nrrd, manifest, scene, obj, gltf, image (default: all)
+#   NAME         nrrd, manifest, volume, scene, obj, gltf, image (default: all)
 # Prints each harness's executions and exits 1 at the first crash, leaving the reproducer named.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -25,7 +25,7 @@ while [ $# -gt 0 ]; do
     *) names+=("$1"); shift ;;
   esac
 done
-[ ${#names[@]} -gt 0 ] || names=(nrrd manifest scene obj gltf image)
+[ ${#names[@]} -gt 0 ] || names=(nrrd manifest volume scene obj gltf image)
 command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ is missing (bash scripts/setup.sh installs it)" >&2; exit 2; }
 if [ ! -f "$build/CMakeCache.txt" ]; then
   CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEIKONAL_FUZZ=ON \

@@ -17,6 +17,7 @@ using test_support::writeFile;
 struct ProgramResult {
   int exit_code = -1;
   std::string output;  // stdout and stderr together
+  long peak_rss_kib = 0;  // the program's peak resident memory (getrusage ru_maxrss of the child)
 };
 
 // Runs `program` with `args` in `cwd`; EIKONAL_THREADS etc. are inherited. With `signal_number`,
