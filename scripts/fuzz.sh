@@ -30,6 +30,8 @@ command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ is missing (bash scrip
 if [ ! -f "$build/CMakeCache.txt" ]; then
   CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEIKONAL_FUZZ=ON \
     -DEIKONAL_BUILD_TESTS=OFF -DEIKONAL_BUILD_BENCHMARKS=OFF >/dev/null
+else
+  cmake -S "$root" -B "$build" >/dev/null  # picks up harnesses added since the build folder was made
 fi
 targets=()
 for name in "${names[@]}"; do targets+=("fuzz_$name"); done
