@@ -34,6 +34,11 @@ inline const std::filesystem::path& workDirectory() {
 inline std::filesystem::path inputFile(const char* name, const std::uint8_t* data, std::size_t size) {
   const std::filesystem::path path = workDirectory() / name;
   std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) {  // the folder was removed under us (a cleanup of another run): make it again
+    std::error_code ec;
+    std::filesystem::create_directories(workDirectory(), ec);
+    f = std::fopen(path.c_str(), "wb");
+  }
   if (!f) std::abort();
   if (size > 0 && std::fwrite(data, 1, size, f) != size) std::abort();
   std::fclose(f);

@@ -69,4 +69,9 @@ for name in "${names[@]}"; do
   rm -f "$build"/fuzz-*.log
   echo "fuzz.sh: fuzz_$name: $runs inputs, no crash"
 done
-rm -rf /dev/shm/eikonal-fuzz-* /tmp/eikonal-fuzz-*
+# The harnesses' input folders (eikonal-fuzz-PID) of processes that have ended; not those of a
+# campaign still running beside this one.
+for dir in /dev/shm/eikonal-fuzz-* /tmp/eikonal-fuzz-*; do
+  [ -d "$dir" ] || continue
+  kill -0 "${dir##*-}" 2>/dev/null || rm -rf "$dir"
+done
