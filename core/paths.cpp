@@ -30,7 +30,7 @@ bool isInsideFolder(const fs::path& path, const fs::path& folder) {
   const fs::path f = resolved(folder);
   auto pi = p.begin();
   for (auto fi = f.begin(); fi != f.end(); ++fi, ++pi) {
-    if (fi->empty()) continue;  // a trailing separator
+    if (fi->empty()) break;  // a trailing separator ends the folder
     if (pi == p.end() || *pi != *fi) return false;
   }
   for (; pi != p.end(); ++pi)
