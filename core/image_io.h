@@ -33,10 +33,12 @@ void writeImage(const std::filesystem::path& path, const Image& image, const Ima
 // 16384 on llvmpipe).
 constexpr int kMaxImageAxis = 16384;
 
-// Reads any format OpenImageIO knows as linear float RGB(A) (sRGB-encoded 8-bit files are
-// linearised). InputError naming the file when it cannot be read, when its header claims more than
-// kMaxImageAxis pixels an axis or more memory than the machine has (core/limits.h), both checked
-// before a pixel is allocated, or when a pixel is not finite.
+// Reads .exr, .hdr, .png, .jpg or .tif, with the reader the extension names and no other, as linear
+// float RGB(A) (sRGB-encoded 8/16-bit files are linearised). InputError naming the file when it
+// cannot be read, when its header claims more than kMaxImageAxis pixels an axis or more memory
+// than the machine has (core/limits.h), both checked before a pixel is allocated, when its OpenEXR
+// header or PNG chunks fail the walks of core/image_headers.h (before their libraries read them),
+// or when a pixel is not finite.
 Image readImage(const std::filesystem::path& path);
 
 }  // namespace eik

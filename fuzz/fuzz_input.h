@@ -47,7 +47,7 @@ inline std::filesystem::path inputFile(const char* name, const std::uint8_t* dat
 
 // The readers' memory limit (core/limits.h) well under libFuzzer's -rss_limit_mb (2048 by default):
 // a header that asks for more must be refused before the allocation.
-inline void limitMemory() { ::setenv("EIKONAL_MEMORY_LIMIT_BYTES", "536870912", 1); }
+inline void limitMemory(const char* bytes = "536870912") { ::setenv("EIKONAL_MEMORY_LIMIT_BYTES", bytes, 1); }
 
 // Runs a reader on one input: InputError is the expected refusal; everything else propagates.
 template <typename Read>

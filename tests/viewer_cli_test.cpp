@@ -80,6 +80,15 @@ TEST(ViewerCli, BadInputExitsTwo) {
   // Radiance headers that claim far more pixels than the file holds.
   writeFile(dir / "huge.hdr", std::string("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 32768 +X 32768\n") + "\x02\x02\x80\x00");
   writeFile(dir / "big.hdr", std::string("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 16000 +X 16000\n") + "\x02\x02\x80\x00");
+  // The reader is the extension's: a PNG named .exr is refused as an EXR (no other reader tried),
+  // an extension no reader has is refused before the file is opened.
+  Image tiny;
+  tiny.width = tiny.height = 2;
+  tiny.channels = 3;
+  tiny.pixels.assign(12, 0.5f);
+  writeImage(dir / "real.png", tiny);
+  std::filesystem::copy_file(dir / "real.png", dir / "png_named.exr");
+  writeFile(dir / "map.txt", "0.5 0.5 0.5");
   Volume no_ior = readVolume(dir / "ball.vol.json");
   no_ior.fields.erase("ior");
   writeVolume(no_ior, dir / "noior.vol.json");
@@ -98,6 +107,8 @@ TEST(ViewerCli, BadInputExitsTwo) {
       {{"ball.vol.json", "--render", "x.png", "--env", "uniform:1,-1,0"}, "--env"},
       {{"ball.vol.json", "--render", "x.png", "--env", "missing.exr"}, "missing.exr"},
       {{"ball.vol.json", "--render", "x.png", "--env", "garbage.exr"}, "garbage.exr"},
+      {{"ball.vol.json", "--render", "x.png", "--env", "png_named.exr"}, "png_named.exr: not an OpenEXR file"},
+      {{"ball.vol.json", "--render", "x.png", "--env", "map.txt"}, "map.txt: unknown image type '.txt'"},
       {{"env_missing.json", "--render", "x.png"}, "nowhere.exr"},
       {{"ball.vol.json", "--render", "x.png", "--env", "huge.hdr"}, "huge.hdr: size: 32768x32768 is larger than 16384"},
       {{"env_unknown.json", "--render", "x.png"}, "environment.procedural"},
