@@ -52,18 +52,23 @@ void expectRefusedBy(Check check, const fs::path& path, const std::string& bytes
   }
 }
 
+// An image of one value, for OpenImageIO to write as the formats' own libraries do.
+Image flatImage(int width, int height, int channels, float value) {
+  Image image;
+  image.width = width;
+  image.height = height;
+  image.channels = channels;
+  image.pixels.assign(static_cast<std::size_t>(width) * height * channels, value);
+  return image;
+}
+
 void expectRefused(const fs::path& dir, const std::string& bytes, const std::string& expected) {
   expectRefusedBy([](const fs::path& p) { checkExrHeaders(p, kMaxImageAxis); }, dir / "map.exr", bytes, expected);
 }
 
 TEST(ExrHeader, AFileOpenExrWroteIsAccepted) {
   TempDir dir("eikonal-exr");
-  Image image;
-  image.width = 5;
-  image.height = 3;
-  image.channels = 4;
-  image.pixels.assign(60, 0.25f);
-  writeImage(dir.path() / "real.exr", image);
+  writeImage(dir.path() / "real.exr", flatImage(5, 3, 4, 0.25f));
   EXPECT_NO_THROW(checkExrHeaders(dir.path() / "real.exr", kMaxImageAxis));
   // And the hand-built header passes the walk (so the refusals below are each one's own fault).
   writeFile(dir.path() / "built.exr", kMagic + version() + header() + std::string(64, '\0'));
@@ -175,12 +180,7 @@ void expectPngRefused(const fs::path& dir, const std::string& bytes, const std::
 
 TEST(PngChunks, AFileLibpngWroteIsAccepted) {
   TempDir dir("eikonal-png");
-  Image image;
-  image.width = 5;
-  image.height = 3;
-  image.channels = 3;
-  image.pixels.assign(45, 0.5f);
-  writeImage(dir.path() / "real.png", image);
+  writeImage(dir.path() / "real.png", flatImage(5, 3, 3, 0.5f));
   EXPECT_NO_THROW(checkPngChunks(dir.path() / "real.png"));
   // Hand-built chunks, a text that inflates to 1 MB among them, pass (the refusals below are each
   // one's own fault).
