@@ -33,8 +33,8 @@ void writeImage(const std::filesystem::path& path, const Image& image, const Ima
 // 16384 on llvmpipe).
 constexpr int kMaxImageAxis = 16384;
 
-// Reads .exr, .hdr, .png, .jpg or .tif, with the reader the extension names and no other, as linear
-// float RGB(A) (sRGB-encoded 8/16-bit files are linearised). InputError naming the file when it
+// Reads .exr, .hdr or .png, with the reader the extension names and no other, as linear float
+// RGB(A) (sRGB-encoded 8/16-bit PNGs are linearised). InputError naming the file when it
 // cannot be read, when its header claims more than kMaxImageAxis pixels an axis or more memory
 // than the machine has (core/limits.h), both checked before a pixel is allocated, when its OpenEXR
 // header or PNG chunks fail the walks of core/image_headers.h (before their libraries read them),

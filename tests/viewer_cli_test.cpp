@@ -89,6 +89,7 @@ TEST(ViewerCli, BadInputExitsTwo) {
   writeImage(dir / "real.png", tiny);
   std::filesystem::copy_file(dir / "real.png", dir / "png_named.exr");
   writeFile(dir / "map.txt", "0.5 0.5 0.5");
+  writeFile(dir / "map.jpg", "\xff\xd8\xff\xe0");
   Volume no_ior = readVolume(dir / "ball.vol.json");
   no_ior.fields.erase("ior");
   writeVolume(no_ior, dir / "noior.vol.json");
@@ -109,6 +110,7 @@ TEST(ViewerCli, BadInputExitsTwo) {
       {{"ball.vol.json", "--render", "x.png", "--env", "garbage.exr"}, "garbage.exr"},
       {{"ball.vol.json", "--render", "x.png", "--env", "png_named.exr"}, "png_named.exr: not an OpenEXR file"},
       {{"ball.vol.json", "--render", "x.png", "--env", "map.txt"}, "map.txt: unknown image type '.txt'"},
+      {{"ball.vol.json", "--render", "x.png", "--env", "map.jpg"}, "map.jpg: unknown image type '.jpg' (read: .exr, .hdr, .png)"},
       {{"env_missing.json", "--render", "x.png"}, "nowhere.exr"},
       {{"ball.vol.json", "--render", "x.png", "--env", "huge.hdr"}, "huge.hdr: size: 32768x32768 is larger than 16384"},
       {{"env_unknown.json", "--render", "x.png"}, "environment.procedural"},

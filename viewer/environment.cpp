@@ -67,7 +67,7 @@ void applyEnvironmentFlag(const std::string& text, SceneEnvironmentSpec& env) {
     env.uniform.reset();
     env.file = text;  // resolved against the working directory (main.cpp makes it absolute)
   } else {
-    throw InputError("--env", text, "expected FILE (.exr, .hdr, ...), uniform:R,G,B, checker[:R,G,B] or sky");
+    throw InputError("--env", text, "expected FILE (.exr, .hdr or .png), uniform:R,G,B, checker[:R,G,B] or sky");
   }
 }
 

@@ -63,7 +63,7 @@ int run(int argc, char** argv) {
   app.add_option("--size", size_text, "image size WxH (default: the scene's render.size, else 512x512)");
   app.add_option("--camera", camera_text, "EX,EY,EZ:TX,TY,TZ:FOVY_DEG (default: the scene's camera, or framing the volume)");
   app.add_option("--env", env_text,
-                 "FILE (equirectangular .exr/.hdr/...) | uniform:R,G,B | checker[:R,G,B] | sky "
+                 "FILE (equirectangular .exr, .hdr or .png) | uniform:R,G,B | checker[:R,G,B] | sky "
                  "(default: the scene's environment, else white)");
   app.add_option("--step", step, "ray step in voxels (default: the scene's render.step_voxels, else 0.5)")->check(CLI::Range(0.01, 4.0));
   app.add_option("--integrator", integrator_text, "ray integrator: euler | rk4 (default euler)");
