@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 
 #include "core/error.h"
 #include "core/image_io.h"
@@ -119,6 +120,23 @@ TEST(ExrHeader, AValueOpenExrReadsToAnotherLengthThanItsSizeIsRefused) {
                                        attribute("names", "stringvector", int32(2) + "ab" + int32(0)) + header() +
                                        std::string(16, '\0'));
   EXPECT_NO_THROW(checkExrHeaders(dir.path() / "ok.exr", kMaxImageAxis));
+}
+
+// The two inputs fuzz_image found, as it found them, through readImage (as the viewer reads an
+// environment map): refused by the walks, before OpenEXR or libpng allocate.
+TEST(ImageHeaders, TheFuzzFindingsAreRefusedByTheWalks) {
+  const fs::path corpus = fs::path(EIKONAL_SOURCE_DIR) / "fuzz" / "corpus" / "image";
+  const std::pair<const char*, const char*> findings[] = {
+      {"found-chlist-runs-past-its-size.exr", "channels: chlist value: a channel runs past the value"},
+      {"found-png-chunk-longer-than-file.png", "chunk tEXt: declares 1634886912 bytes but the file has 148 left"}};
+  for (const auto& [name, expected] : findings) {
+    try {
+      readImage(corpus / name);
+      ADD_FAILURE() << name << " was read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << name << ": " << e.what();
+    }
+  }
 }
 
 TEST(ExrHeader, ADataWindowOrTilesOverTheLimitAreRefused) {
