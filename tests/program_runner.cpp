@@ -5,15 +5,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <chrono>
 #include <csignal>
 #include <stdexcept>
-#include <thread>
 
 namespace eik::test {
 
 ProgramResult runProgram(const std::string& program, const std::vector<std::string>& args,
-                         const std::filesystem::path& cwd, int signal_number, double signal_after_s) {
+                         const std::filesystem::path& cwd, int signal_number,
+                         const std::string& signal_when_output_has) {
   int pipe_fd[2];
   if (pipe(pipe_fd) != 0) throw std::runtime_error("pipe failed");
   pid_t pid = fork();
@@ -34,21 +33,19 @@ ProgramResult runProgram(const std::string& program, const std::vector<std::stri
     _exit(127);
   }
   close(pipe_fd[1]);
-  std::thread signaller;
-  if (signal_number != 0)
-    signaller = std::thread([pid, signal_number, signal_after_s] {
-      std::this_thread::sleep_for(std::chrono::duration<double>(signal_after_s));
-      kill(pid, signal_number);  // the child is not reaped before this thread is joined
-    });
+  bool signalled = signal_number == 0;
   ProgramResult result;
   char buffer[4096];
   for (;;) {
     ssize_t n = read(pipe_fd[0], buffer, sizeof buffer);
     if (n <= 0) break;
     result.output.append(buffer, static_cast<std::size_t>(n));
+    if (!signalled && result.output.find(signal_when_output_has) != std::string::npos) {
+      kill(pid, signal_number);  // the child is not reaped before the wait below
+      signalled = true;
+    }
   }
   close(pipe_fd[0]);
-  if (signaller.joinable()) signaller.join();
   int status = 0;
   struct rusage usage {};
   wait4(pid, &status, 0, &usage);

@@ -21,8 +21,11 @@ struct ProgramResult {
 };
 
 // Runs `program` with `args` in `cwd`; EIKONAL_THREADS etc. are inherited. With `signal_number`,
-// sends it that signal `signal_after_s` seconds after the start (a user's Ctrl-C, a kill).
+// sends it that signal (a user's Ctrl-C, a kill) once its output contains `signal_when_output_has`:
+// a marker the program prints when it is at work, so the signal never lands before the program has
+// started (a timed signal did, under a sanitizer build on a loaded machine).
 ProgramResult runProgram(const std::string& program, const std::vector<std::string>& args,
-                         const std::filesystem::path& cwd, int signal_number = 0, double signal_after_s = 0.0);
+                         const std::filesystem::path& cwd, int signal_number = 0,
+                         const std::string& signal_when_output_has = {});
 
 }  // namespace eik::test
