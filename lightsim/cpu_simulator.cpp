@@ -129,14 +129,17 @@ bool oneMedium(const Patch& p) {
   return p.medium[0] == p.medium[1] && p.medium[1] == p.medium[2] && p.medium[2] == p.medium[3];
 }
 
-// The sub-path lattice of a patch (track_deposit.h): ≤ ½ voxel between neighbours along u and v.
-glm::ivec2 subPathLattice(const Patch& before, const Patch& after, double h) {
+// The sub-path lattice of a patch-step carrying `flux` (track_deposit.h): ≤ ½ voxel between
+// neighbours along u and v, or ≤ 1 voxel for dim light (trackSpacing).
+glm::ivec2 subPathLattice(const Patch& before, const Patch& after, const glm::dvec3& flux, double h,
+                          double dim_irradiance) {
   auto longest = [](const Patch& p, int a, int b, int c, int d) {
     return std::max(glm::length(p.x[b] - p.x[a]), glm::length(p.x[c] - p.x[d]));
   };
   const double u = std::max(longest(before, 0, 1, 2, 3), longest(after, 0, 1, 2, 3));
   const double v = std::max(longest(before, 1, 2, 3, 0), longest(after, 1, 2, 3, 0));
-  return {trackLattice(u / h), trackLattice(v / h)};
+  const double spacing = trackSpacing(maxChannel(flux), std::min(before.area(), after.area()), dim_irradiance);
+  return {trackLattice(u / h, spacing), trackLattice(v / h, spacing)};
 }
 
 // Step 1 with sharp interfaces: every corner crosses the interfaces on its way. Returns the
@@ -394,7 +397,7 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
     result.track = true;
     result.from = before.x;
     result.track_flux = 0.5 * (before.flux + patch.flux);  // the flux along the step (trapezoid)
-    result.lattice = subPathLattice(before, patch, h);
+    result.lattice = subPathLattice(before, patch, result.track_flux, h, ctx.dim_irradiance);
     result.clip_to_receiver = reached;
   } else {
     result.voxel = containingVoxel(grid, m_new);
@@ -522,10 +525,11 @@ void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<Pat
     for (int slab = k0 / slab_depth; slab <= k1 / slab_depth && slab < slabs; ++slab)
       by_slab[static_cast<std::size_t>(slab)].push_back(static_cast<std::uint32_t>(i));
   }
-  const std::size_t slice = static_cast<std::size_t>(grid.dims.x) * static_cast<std::size_t>(grid.dims.y);
+  const long long sy = grid.dims.x, sz = static_cast<long long>(grid.dims.x) * grid.dims.y;
+  const long long corner_offset[8] = {0, 1, sy, 1 + sy, sz, 1 + sz, sy + sz, 1 + sy + sz};
   parallelFor(0, slabs, [&](std::int64_t slab64) {
-    const std::size_t lo = static_cast<std::size_t>(slab64) * static_cast<std::size_t>(slab_depth) * slice;
-    const std::size_t hi = std::min(grid.count(), lo + static_cast<std::size_t>(slab_depth) * slice);
+    // This slab's slices, z0 ≤ z < z1: a voxel belongs to one slab.
+    const int z0 = static_cast<int>(slab64) * slab_depth, z1 = std::min(grid.dims.z, z0 + slab_depth);
     for (const std::uint32_t i : by_slab[static_cast<std::size_t>(slab64)]) {
       const PatchStepResult& r = results[i];
       const Patch& p = patches[i];
@@ -568,12 +572,27 @@ void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<Pat
             e *= f1 - f0;
             dsum *= f1 - f0;
           }
-          forEachTrackWeight(va, vb, grid.dims, [&](long long v, double w) {
-            const std::size_t at = static_cast<std::size_t>(v);
-            if (at - lo >= hi - lo) return;  // another slab's voxel (unsigned: also below lo)
-            DepositSum& sum = sums[at];
-            sum.irradiance += e * w;
-            sum.direction += dsum * w;
+          forEachTrackCell(va, vb, grid.dims, [&](const TrackCell& c) {
+            // The cell's two slices of voxels, each in this slab or not; within the grid
+            // otherwise, as TrackCell::interior says, or checked voxel by voxel.
+            const bool low_in = c.cell.z >= z0 && c.cell.z < z1, high_in = c.cell.z + 1 >= z0 && c.cell.z + 1 < z1;
+            if (c.interior && low_in && high_in) {
+              for (int k = 0; k < 8; ++k) {
+                DepositSum& sum = sums[static_cast<std::size_t>(c.origin + corner_offset[k])];
+                const double w = c.weight[static_cast<std::size_t>(k)];
+                sum.irradiance += e * w;
+                sum.direction += dsum * w;
+              }
+              return;
+            }
+            for (int k = 0; k < 8; ++k) {
+              const int x = c.cell.x + (k & 1), y = c.cell.y + ((k >> 1) & 1), z = c.cell.z + ((k >> 2) & 1);
+              if (x < 0 || y < 0 || z < z0 || x >= grid.dims.x || y >= grid.dims.y || z >= z1) continue;
+              DepositSum& sum = sums[static_cast<std::size_t>(c.origin + corner_offset[k])];
+              const double w = c.weight[static_cast<std::size_t>(k)];
+              sum.irradiance += e * w;
+              sum.direction += dsum * w;
+            }
           });
         }
     }
@@ -613,6 +632,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   double flux_ref = 0.0;
   std::vector<Patch> patches = initialPatches(light, grid, sampler_, options, &flux_ref, ctx.receiver);
   ctx.flux_ref = flux_ref;
+  ctx.dim_irradiance = kDimTrackFraction * brightestIrradiance(light, grid);
   stats.initial_patches = patches.size();
   for (const Patch& p : patches) stats.flux_in += p.flux;
   stats.phase_seconds["init"] = phase.seconds();

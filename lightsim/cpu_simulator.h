@@ -85,6 +85,9 @@ struct StepContext {
   const SimulationOptions* options = nullptr;
   double dt = 0.0;           // Δt
   double flux_ref = 0.0;     // Φ_ref
+  // Track deposits: patch-steps under this irradiance take the dim light's sub-path lattice
+  // (track_deposit.h trackSpacing; kDimTrackFraction of brightestIrradiance). 0: none does.
+  double dim_irradiance = 0.0;
   double voxel_volume = 0.0;
   glm::dvec3 box_lo{0.0}, box_hi{0.0};  // propagationBox
   const ReceiverMap* receiver = nullptr; // the receiver's geometry (no data), or none

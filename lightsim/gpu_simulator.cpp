@@ -28,6 +28,7 @@
 #include "lightsim/receiver.h"
 #include "lightsim/receiver_pass.h"
 #include "lightsim/step_uniforms.h"
+#include "lightsim/track_deposit.h"
 #include "lightsim/track_deposit_pass.h"
 #include "lightsim/update_pass.h"
 #include "lightsim/wavefront.h"
@@ -323,6 +324,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     trackUniforms.receiverEnabled = options.receiver.has_value();
     trackUniforms.receiverPoint = step.receiverPoint;
     trackUniforms.receiverNormal = step.receiverNormal;
+    trackUniforms.dimIrradiance = static_cast<float>(kDimTrackFraction * brightestIrradiance(light, grid));
     const double extent = 2.0 * kMaxUnsplitEdge * options.split_voxels + options.step_voxels;
     trackUniforms.maxExtentVoxels =
         std::min(trackPassFor().maxExtentVoxels(), static_cast<int>(std::ceil(1.5 * extent)) + 2);

@@ -76,6 +76,7 @@ void TrackDepositPass::run(const PatchTextures& before, const PatchTextures& aft
   program_.setSampler("uTrackInfo", kTrackInfoUnit);
   uniforms.grid.set(program_);
   program_.set("uInvVoxelVolume", 1.0f / uniforms.grid.voxelVolume);
+  program_.set("uDimIrradiance", uniforms.dimIrradiance);
   program_.set("uClipEnabled", uniforms.receiverEnabled);
   program_.set("uReceiverPoint", uniforms.receiverPoint);
   program_.set("uReceiverNormal", uniforms.receiverNormal);

@@ -65,6 +65,10 @@ struct TrackDepositUniforms {
   // number of z-slices drawn per patch and the largest point size. A patch-step beyond the bound
   // loses the voxels past maxExtentVoxels + 2 from the low corner of its box along that axis.
   int maxExtentVoxels = 8;
+  // Patch-steps whose irradiance (track flux, max channel, over the smaller of the two corner
+  // quadrilaterals' areas) is under this take the 1-voxel lattice (track_deposit.h trackSpacing;
+  // StepContext::dim_irradiance). 0: every patch-step takes the ½-voxel lattice.
+  float dimIrradiance = 0.0f;
 };
 
 class TrackDepositPass {

@@ -459,6 +459,14 @@ std::vector<Patch> pointPatches(const LightSpec& light, const GridSpec& grid, co
 
 }  // namespace
 
+double brightestIrradiance(const LightSpec& light, const GridSpec& grid) {
+  const double power = std::max(light.power.x, std::max(light.power.y, light.power.z));
+  if (light.type == LightSpec::Type::Directional) return power;
+  const glm::dvec3 nearest = glm::clamp(light.position, grid.bounds_min, grid.bounds_max);
+  const double d2 = glm::dot(nearest - light.position, nearest - light.position);
+  return d2 > 0.0 ? power / d2 : 0.0;
+}
+
 void validateLight(const LightSpec& light) {
   if (!finite3(light.power)) throw InputError("light", "power", "must be finite");
   if (light.power.x < 0.0 || light.power.y < 0.0 || light.power.z < 0.0)

@@ -231,6 +231,10 @@ const std::array<CubeFace, 6>& cubeFaces();
 // and the cube-map resolution M = clamp(ceil(2·r₀/(patch_voxels·h)), 1, 2048): a cell's chord at
 // r₀ is then at most patch_voxels·h (the largest cell, at a face centre, subtends atan(2/M) < 2/M).
 double pointLightStartRadius(const glm::dvec3& position, const GridSpec& grid);
+// The brightest irradiance the light itself (unfocused) puts anywhere in the grid, max channel:
+// a directional light's own; a point light's intensity over its squared distance to the grid's
+// box (0 when it is inside the box: no bound). The reference of track_deposit.h trackSpacing.
+double brightestIrradiance(const LightSpec& light, const GridSpec& grid);
 int pointLightCubeResolution(double start_radius, const GridSpec& grid, const SimulationOptions& options);
 constexpr int kMaxCubeResolution = 2048;
 

@@ -19,6 +19,7 @@ uniform vec3 uBoundsMin;       // the grid in the corners' frame (GridUniforms)
 uniform vec3 uBoundsMax;
 uniform ivec3 uDims;
 uniform float uVoxelEdge;      // h of the sub-path lattice (the smallest voxel edge)
+uniform float uDimIrradiance;  // patch-steps under this irradiance take the 1-voxel lattice (0: none)
 uniform bool uClipEnabled;     // a receiver plane exists (applyTrackDeposits: `receiver`)
 uniform vec3 uReceiverPoint;
 uniform vec3 uReceiverNormal;  // unit, pointing to the side the light comes from
@@ -32,14 +33,17 @@ flat out vec4 vFlux;       // (Φ_sub = track_flux/(n_u·n_v), clip at the recei
 flat out ivec4 vBox;       // the voxel box in this slice: (i_min, j_min, i_max, j_max), inclusive
 flat out ivec4 vTile;      // (tile origin x, y in the atlas, slice k, n_u + 32·n_v)
 
-// track_deposit.h trackLattice: n = ⌈edge / ½ voxel⌉, 1 ≤ n ≤ kMaxTrackLattice (16). The CPU's
-// allowance (1e-9 in double) becomes 1e-4 half-voxels in float, so that an edge of exactly k/2
-// voxels, which float corners carry with a relative error of ~1e-7 × the coordinates, still gets
-// the CPU's k sub-paths.
-int trackLattice(float edgeVoxels) {
-  if (!(edgeVoxels > 0.5)) return 1;
-  return int(min(16.0, ceil(edgeVoxels * 2.0 - 1e-4)));
+// track_deposit.h trackLattice: n = ⌈edge / spacing⌉, 1 ≤ n ≤ kMaxTrackLattice (16), the spacing
+// ½ voxel, or 1 voxel for dim light (trackSpacing). The CPU's allowance (1e-9 in double) becomes
+// 1e-4 spacings in float, so that an edge of exactly k spacings, which float corners carry with a
+// relative error of ~1e-7 × the coordinates, still gets the CPU's k sub-paths.
+int trackLattice(float edgeVoxels, float spacing) {
+  if (!(edgeVoxels > spacing)) return 1;
+  return int(min(16.0, ceil(edgeVoxels / spacing - 1e-4)));
 }
+
+// The area of a corner quadrilateral, Patch::area: ½ |(x₂ − x₀) × (x₃ − x₁)|.
+float quadArea(vec3 x0, vec3 x1, vec3 x2, vec3 x3) { return 0.5 * length(cross(x2 - x0, x3 - x1)); }
 
 // A corner for track_deposit.frag: (voxel coordinates, height above the receiver plane).
 vec4 voxelCorner(vec3 x, vec3 voxelSize) {
@@ -80,7 +84,11 @@ void main() {
   // v edges (x₁x₂, x₀x₃), before or after the step, in units of h.
   float eu = max(max(length(a1 - a0), length(a2 - a3)), max(length(b1 - b0), length(b2 - b3)));
   float ev = max(max(length(a2 - a1), length(a3 - a0)), max(length(b2 - b1), length(b3 - b0)));
-  int nu = trackLattice(eu / uVoxelEdge), nv = trackLattice(ev / uVoxelEdge);
+  // track_deposit.h trackSpacing: the flux (max channel) against the irradiance bound times the
+  // smaller of the two areas.
+  float area = min(quadArea(a0, a1, a2, a3), quadArea(b0, b1, b2, b3));
+  float spacing = uDimIrradiance > 0.0 && max(info.r, max(info.g, info.b)) < uDimIrradiance * area ? 1.0 : 0.5;
+  int nu = trackLattice(eu / uVoxelEdge, spacing), nv = trackLattice(ev / uVoxelEdge, spacing);
 
   vBefore[0] = voxelCorner(a0, voxelSize); vBefore[1] = voxelCorner(a1, voxelSize);
   vBefore[2] = voxelCorner(a2, voxelSize); vBefore[3] = voxelCorner(a3, voxelSize);
