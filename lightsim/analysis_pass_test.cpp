@@ -33,6 +33,7 @@ int fateCode(const PatchStepResult& r) {
     case PatchFate::KilledDepth: return 8;
     case PatchFate::Received: return 9;
     case PatchFate::Blocked: return 10;
+    case PatchFate::Trapped: return 11;
   }
   return 0;
 }

@@ -65,7 +65,8 @@ nlohmann::json SimulationStats::toJson() const {
   j["total_patches"] = total_patches;
   j["splits"] = splits;
   j["kills"] = {{"flux", kills.flux},         {"exited", kills.exited},     {"folded", kills.folded},
-                {"depth", kills.depth},       {"received", kills.received}, {"blocked", kills.blocked}};
+                {"depth", kills.depth},       {"received", kills.received}, {"blocked", kills.blocked},
+                {"trapped", kills.trapped}};
   j["reflections"] = reflections;
   j["rollbacks"] = rollbacks;
   j["flights"] = flights;

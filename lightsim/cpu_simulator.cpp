@@ -120,9 +120,10 @@ namespace {
 // A step that would tear a patch (its edges past this many split lengths after crossing an
 // interface) is undone and the patch split before it crosses (ALGORITHM.md "Sharp interfaces").
 constexpr double kTearFactor = 2.0;
-// Total internal reflections (all corners together) after which a patch counts as trapped and dies:
-// on a voxelised sphere the rays that enter at grazing incidence can meet the far side just past
-// the critical angle and circle inside it for ever.
+// Total internal reflections (all corners together) after which a patch counts as trapped and stops,
+// its flux counted as unfinished (light still travelling, as at the step limit): on a voxelised
+// sphere the rays that enter at grazing incidence can meet the far side just past the critical
+// angle and circle inside it for ever, and in a block light can bounce between its faces.
 constexpr int kMaxTotalReflections = 16;
 
 bool oneMedium(const Patch& p) {
@@ -421,7 +422,7 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
   } else if (crossing.blocked >= 2) {
     result.fate = PatchFate::Blocked;
   } else if (patch.reflections > kMaxTotalReflections) {
-    result.fate = PatchFate::KilledDepth;  // trapped by total internal reflection (a whispering gallery)
+    result.fate = PatchFate::Trapped;  // by total internal reflection (a whispering gallery, a block)
   } else if (maxChannel(patch.flux) < fluxKillThreshold(ctx.flux_ref, options, patch.depth)) {
     result.fate = PatchFate::KilledFlux;
   } else if (!inside && !rayHitsBox(m_new, d_new, ctx.box_lo, ctx.box_hi)) {
@@ -725,6 +726,10 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
         case PatchFate::KilledDepth:
           ++stats.kills.depth;
           stats.flux_killed += p.flux;
+          break;
+        case PatchFate::Trapped:
+          ++stats.kills.trapped;
+          stats.flux_unfinished += p.flux;
           break;
         case PatchFate::Received:
           ++stats.kills.received;

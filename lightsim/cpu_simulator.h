@@ -50,7 +50,8 @@ class CpuSimulator : public Simulator {
 
 // One step of one patch in place: ALGORITHM.md steps 1–5 (update, absorption, Fresnel, deposit
 // record, analysis). Exposed so that tests and the GPU path can check single steps.
-enum class PatchFate { Keep, Split, KilledFlux, Exited, Folded, KilledDepth, Received, Blocked };
+// Trapped: more than kMaxTotalReflections total internal reflections (its flux is unfinished light).
+enum class PatchFate { Keep, Split, KilledFlux, Exited, Folded, KilledDepth, Received, Blocked, Trapped };
 
 struct PatchStepResult {
   PatchFate fate = PatchFate::Keep;

@@ -345,7 +345,8 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
       const glm::dvec4 retired = ledger.sum(gpu::kExited) + ledger.sum(gpu::kAbsorbed) +
                                  ledger.sum(gpu::kReflected) + ledger.sum(gpu::kKilledFlux) +
                                  ledger.sum(gpu::kFolded) + ledger.sum(gpu::kKilledDepth) +
-                                 ledger.sum(gpu::kReceived) + ledger.sum(gpu::kBlocked);
+                                 ledger.sum(gpu::kReceived) + ledger.sum(gpu::kBlocked) +
+                                 ledger.sum(gpu::kUnfinished);  // trapped light, until the end
       options.progress(std::min(1.0, luminance(glm::dvec3(retired)) / totalIn));
     }
   };
@@ -415,6 +416,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     count = static_cast<std::size_t>(total);
     if (ledger.full()) report();
   }
+  const std::size_t unfinished_at_end = count;
   if (count > 0) ledger.addUnfinished(lists->a, count);
   report();
   timer.collect(true);
@@ -430,6 +432,10 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   stats.flux_killed =
       glm::dvec3(ledger.sum(gpu::kKilledFlux) + ledger.sum(gpu::kFolded) + ledger.sum(gpu::kKilledDepth));
   stats.flux_unfinished = glm::dvec3(ledger.sum(gpu::kUnfinished));
+  // The unfinished entry counts the trapped patches and the list left at the end.
+  const double unfinished_patches = ledger.sum(gpu::kUnfinished).w;
+  stats.kills.trapped =
+      static_cast<std::uint64_t>(std::max(0.0, std::round(unfinished_patches) - static_cast<double>(unfinished_at_end)));
   stats.kills.received = static_cast<std::uint64_t>(std::llround(ledger.sum(gpu::kReceived).w));
   stats.kills.blocked = static_cast<std::uint64_t>(std::llround(ledger.sum(gpu::kBlocked).w));
   stats.flux_received = glm::dvec3(ledger.sum(gpu::kReceived));

@@ -23,8 +23,8 @@ TEST(LedgerPassTest, OneStepSumsTheCpuTwinsLedger) {
   test_scenes::MidFlightList list;
   // The twin's ledger of one step (CpuSimulator::run): the sums over the results, dead patches
   // with their flux after the update.
-  glm::dvec3 absorbed(0.0), reflected(0.0), exited(0.0), killed(0.0), updated(0.0);
-  double exits = 0.0, kills = 0.0, splits = 0.0;
+  glm::dvec3 absorbed(0.0), reflected(0.0), exited(0.0), killed(0.0), trapped(0.0), updated(0.0);
+  double exits = 0.0, kills = 0.0, traps = 0.0, splits = 0.0;
   for (Patch p : list.patches) {
     const PatchStepResult r = stepPatch(p, list.ctx);
     absorbed += r.absorbed;
@@ -37,6 +37,10 @@ TEST(LedgerPassTest, OneStepSumsTheCpuTwinsLedger) {
     if (r.fate == PatchFate::KilledFlux || r.fate == PatchFate::Folded || r.fate == PatchFate::KilledDepth) {
       killed += p.flux;
       kills += 1.0;
+    }
+    if (r.fate == PatchFate::Trapped) {  // unfinished light
+      trapped += p.flux;
+      traps += 1.0;
     }
     if (r.fate == PatchFate::Split) splits += 1.0;
   }
@@ -74,7 +78,8 @@ TEST(LedgerPassTest, OneStepSumsTheCpuTwinsLedger) {
   EXPECT_EQ(gpuKilled.w, 2.0 * kills);
   EXPECT_EQ(ledger.sum(gpu::kSplits).w, 2.0 * splits);
   EXPECT_GT(splits, 0.0);
-  expectSum(gpu::kUnfinished, updated, static_cast<double>(count), "unfinished");
+  // The trapped patches of both steps, and the list added as unfinished at the end.
+  expectSum(gpu::kUnfinished, updated + 2.0 * trapped, static_cast<double>(count) + 2.0 * traps, "unfinished");
 
   // reset() forgets everything.
   ledger.reset();

@@ -101,6 +101,7 @@ struct KillCounts {
   std::uint64_t depth = 0;    // needed a split beyond max_depth (DepthLimit::Kill only)
   std::uint64_t received = 0; // reached the receiver plane
   std::uint64_t blocked = 0;  // stopped by an opaque material
+  std::uint64_t trapped = 0;  // trapped by total internal reflection (flux counted as unfinished)
 };
 
 struct SimulationStats {
@@ -117,7 +118,7 @@ struct SimulationStats {
   glm::dvec3 flux_absorbed{0.0};
   glm::dvec3 flux_reflected{0.0};    // Fresnel reflection at boundaries
   glm::dvec3 flux_killed{0.0};       // flux, folded and depth kills
-  glm::dvec3 flux_unfinished{0.0};   // still alive at max_steps
+  glm::dvec3 flux_unfinished{0.0};   // still alive at max_steps, or trapped (kills.trapped)
   glm::dvec3 flux_received{0.0};     // absorbed by the receiver plane (its map)
   glm::dvec3 flux_blocked{0.0};      // stopped by opaque materials
   std::uint64_t reflections = 0;     // reflected wavefronts followed (bounces)

@@ -10,6 +10,5 @@ voxelize procedural:logo_block,size=0.6:0.6:0.3,center=0:-0.2:0 -o logo_block.vo
 voxelize procedural:layered_cube,size=0.5,center=0:-0.25:0,scatter=1,g=0.3 -o layered_cube.vol.json \
          --res "$(res 56)" --bounds -0.3,-0.53,-0.55,0.45,0.02,0.3
 for object in wine_glass sphere logo_block layered_cube; do
-  lightsim "$object.vol.json" -o "$object.baked.vol.json" \
-           --max-steps "$(( $(res 64) * 6 ))"
+  lightsim "$object.vol.json" -o "$object.baked.vol.json"
 done

@@ -127,7 +127,7 @@ void main() {
   if (reached) fate = FATE_RECEIVED;
   else if (blocked >= 2) fate = FATE_BLOCKED;
 #ifdef SHARP_INTERFACES
-  else if (p.reflections > kMaxTotalReflections) fate = FATE_DEPTH;
+  else if (p.reflections > kMaxTotalReflections) fate = FATE_TRAPPED;
 #endif
   else fate = patchFate(p, splittable);
   oCount = vec4(fateCount(fate) + (spawns ? 1.0 : 0.0), 0.0, 0.0, 0.0);

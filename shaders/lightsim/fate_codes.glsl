@@ -8,9 +8,10 @@ const int FATE_SPLIT_V = 4;   // count 2: 1×2 split halving v (edges x1x2, x0x3
 const int FATE_EXITED = 5;    // count 0: outside the box, heading away
 const int FATE_FLUX = 6;      // count 0: max(Φ) under the threshold
 const int FATE_FOLDED = 7;    // count 0: N·d ≤ 0 (caustic singularity)
-const int FATE_DEPTH = 8;     // count 0: needs a split beyond max_depth (or torn, or trapped)
+const int FATE_DEPTH = 8;     // count 0: needs a split beyond max_depth (or torn)
 const int FATE_RECEIVED = 9;  // count 0: reached the receiver plane (its flux goes to the map)
 const int FATE_BLOCKED = 10;  // count 0: stopped by an opaque surface (≥ 2 corners)
+const int FATE_TRAPPED = 11;  // count 0: trapped by total internal reflection (its flux: unfinished)
 
 // The analysis stores a fate with two flags in one float (ledger A's w): code = fate +
 // FATE_SPAWNS (the reflected wavefront is followed as a new patch, one more slot) + FATE_ROLLED_BACK

@@ -5,7 +5,7 @@
 //   0 absorbed (Φ, 0)       (step 2)      4 folded kills (Φ, count)
 //   1 reflected (Φ, count)  (step 3)      5 depth kills (Φ, count)
 //   2 exited (Φ, count)     (step 5)      6 splits (0, count)
-//   3 flux kills (Φ, count) (step 5)      7 unfinished (Φ, count), at the end
+//   3 flux kills (Φ, count) (step 5)      7 unfinished (Φ, count): trapped, and at the end
 // The analysis pass computed the per-patch values (ledger A = (absorbed, fate), B = (reflected,
 // event)); this pass only sums them. A row per step (uRow); within it patch k adds into bin
 // k mod uBins, so no texel sums more than count/uBins values in float (bins and rows are summed in
@@ -52,6 +52,7 @@ void main() {
   if (fate == FATE_FLUX) vEntry[3] = dead;
   if (fate == FATE_FOLDED) vEntry[4] = dead;
   if (fate == FATE_DEPTH) vEntry[5] = dead;
+  if (fate == FATE_TRAPPED) vEntry[7] = dead;  // trapped light is unfinished light
   if (fateSplits(fate)) vEntry[6] = vec4(0.0, 0.0, 0.0, 1.0);
   emit = fate >= FATE_SPLIT || b.w > 0.0 || any(notEqual(b.rgb, vec3(0.0))) || any(greaterThan(a.rgb, vec3(0.0)));
 #endif
