@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/error.h"
 #include "core/stopwatch.h"
 #include "gl/framebuffer.h"
 #include "viewer/scene_renderer.h"
@@ -37,27 +38,42 @@ std::vector<double> timeFrames(const std::function<void()>& draw, int frames, bo
   return ms;
 }
 
+BareMarch::BareMarch(const gl::ShaderLibrary& shaders, const std::vector<BareObject>& objects, double step_voxels,
+                     const std::optional<SceneGroundSpec>& ground)
+    : ground_(ground) {
+  if (objects.empty() || objects.size() > static_cast<std::size_t>(kMaxObjects))
+    throw InputError("--bench", std::to_string(objects.size()) + " objects",
+                     "the bare march crosses 1 to " + std::to_string(kMaxObjects) + " objects");
+  for (const BareObject& object : objects) {
+    Packed p;
+    p.grid = object.volume->grid;
+    p.object_to_world = object.object_to_world;
+    const Field& ior = object.volume->require("ior", 1, object.source);
+    const Field& grad = object.volume->require("ior_grad", 3, object.source);
+    const std::size_t count = p.grid.count();
+    std::vector<float> packed(4 * count);
+    for (std::size_t i = 0; i < count; ++i) {
+      packed[4 * i + 0] = grad.data[3 * i + 0];
+      packed[4 * i + 1] = grad.data[3 * i + 1];
+      packed[4 * i + 2] = grad.data[3 * i + 2];
+      packed[4 * i + 3] = ior.data[i];
+    }
+    gl::checkTexture3DSize(p.grid.dims, object.source + " (packed n, grad n)");
+    p.texture = gl::Texture3D(p.grid.dims, gl::TextureFormat::RGBA32F, packed, 4);
+    const glm::dvec3 h = p.grid.voxelSize();
+    p.step = step_voxels * std::min({h.x, h.y, h.z});
+    // The same bound as the renderers: four box diagonals of arc length, and some.
+    p.max_steps = static_cast<int>(std::ceil(4.0 * glm::length(p.grid.extent()) / p.step)) + 16;
+    objects_.push_back(std::move(p));
+  }
+  gl::ShaderDefines defines = {{"OBJECTS", std::to_string(objects_.size())}};
+  if (ground_) defines.emplace_back("GROUND", "1");
+  program_ = shaders.program("common/fullscreen.vert", "viewer/bare_march.frag", defines);
+}
+
 BareMarch::BareMarch(const gl::ShaderLibrary& shaders, const Volume& volume, const glm::dmat4& object_to_world,
                      double step_voxels, const std::string& source)
-    : grid_(volume.grid), object_to_world_(object_to_world) {
-  const Field& ior = volume.require("ior", 1, source);
-  const Field& grad = volume.require("ior_grad", 3, source);
-  const std::size_t count = grid_.count();
-  std::vector<float> packed(4 * count);
-  for (std::size_t i = 0; i < count; ++i) {
-    packed[4 * i + 0] = grad.data[3 * i + 0];
-    packed[4 * i + 1] = grad.data[3 * i + 1];
-    packed[4 * i + 2] = grad.data[3 * i + 2];
-    packed[4 * i + 3] = ior.data[i];
-  }
-  gl::checkTexture3DSize(grid_.dims, source + " (packed n, grad n)");
-  packed_ = gl::Texture3D(grid_.dims, gl::TextureFormat::RGBA32F, packed, 4);
-  const glm::dvec3 h = grid_.voxelSize();
-  step_ = step_voxels * std::min({h.x, h.y, h.z});
-  // The same bound as the renderers: four box diagonals of arc length, and some.
-  max_steps_ = static_cast<int>(std::ceil(4.0 * glm::length(grid_.extent()) / step_)) + 16;
-  program_ = shaders.program("common/fullscreen.vert", "viewer/bare_march.frag");
-}
+    : BareMarch(shaders, std::vector<BareObject>{BareObject{&volume, object_to_world, source}}, step_voxels) {}
 
 void BareMarch::draw(const Camera& camera, glm::ivec2 size) const {
   glViewport(0, 0, size.x, size.y);
@@ -65,14 +81,22 @@ void BareMarch::draw(const Camera& camera, glm::ivec2 size) const {
   program_.use();
   program_.set("uInvViewProj", glm::mat4(camera.inverseViewProjection(aspect)));
   program_.set("uEye", glm::vec3(camera.eye));
-  program_.set("uWorldToVolume", glm::mat4(glm::inverse(object_to_world_)));
-  program_.set("uVolumeToWorldDir", glm::mat3(glm::dmat3(object_to_world_)));
-  program_.set("uBoundsMin", glm::vec3(grid_.bounds_min));
-  program_.set("uBoundsMax", glm::vec3(grid_.bounds_max));
-  program_.set("uStep", static_cast<float>(step_));
-  program_.set("uMaxSteps", max_steps_);
-  packed_.bind(0);
-  program_.set("uPacked", 0);
+  for (std::size_t i = 0; i < objects_.size(); ++i) {
+    const Packed& p = objects_[i];
+    const std::string at = "[" + std::to_string(i) + "]";
+    program_.set("uWorldToVolume" + at, glm::mat4(glm::inverse(p.object_to_world)));
+    program_.set("uVolumeToWorld" + at, glm::mat4(p.object_to_world));
+    program_.set("uBoundsMin" + at, glm::vec3(p.grid.bounds_min));
+    program_.set("uBoundsMax" + at, glm::vec3(p.grid.bounds_max));
+    program_.set("uStep" + at, static_cast<float>(p.step));
+    program_.set("uMaxSteps" + at, p.max_steps);
+    p.texture.bind(static_cast<int>(i));
+    program_.setSampler("uPacked" + at, static_cast<int>(i));
+  }
+  if (ground_) {
+    program_.set("uGroundPoint", glm::vec3(ground_->point));
+    program_.set("uGroundNormal", glm::vec3(glm::normalize(ground_->normal)));
+  }
   triangle_.draw();
 }
 

@@ -1,7 +1,8 @@
 // `viewer --bench N` (docs/programs.md, docs/testing.md "timings belong in benchmarks"): N frames of the full
-// renderer headless, and N frames of a bare refractive march of the same volume (BareMarch, the
-// cost floor of curved-ray casting: Euler steps with ONE fetch a step of a packed n+∇n texture,
-// no shading), each frame ended by glFinish, the median ms/frame of each, and their ratio.
+// renderer headless, and N frames of a bare refractive march of the same scene (BareMarch, the
+// cost floor of curved-ray casting: through every object's box in the order the ray meets them,
+// Euler steps with ONE fetch a step of a packed n+∇n texture, then the ground's hit test; no
+// shading), each frame ended by glFinish, the median ms/frame of each, and their ratio.
 //
 // Samples per second = ray steps per second. The bare march counts its steps exactly (each pixel
 // writes its step count; one untimed extra frame is read back and summed). The full renderer's
@@ -12,6 +13,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/image_io.h"
+#include "core/scene.h"
 #include "core/volume.h"
 #include "gl/program.h"
 #include "gl/shader_library.h"
@@ -35,10 +38,26 @@ double medianOf(std::vector<double> values);
 // unless `warm_up` is false. Milliseconds a frame, in call order.
 std::vector<double> timeFrames(const std::function<void()>& draw, int frames, bool warm_up = true);
 
+// One object of a bare march: its volume (ior and ior_grad), placed by object_to_world.
+struct BareObject {
+  const Volume* volume = nullptr;
+  glm::dmat4 object_to_world{1.0};
+  std::string source = "volume";  // named in errors
+};
+
 class BareMarch {
  public:
-  // Needs a current GL context. Packs the volume's ior and ior_grad (InputError naming `source`
-  // when missing) into one RGBA32F 3D texture; `object_to_world` places it (thesis §6.3.1).
+  // The most objects one bare march crosses (a sampler each).
+  static constexpr int kMaxObjects = 8;
+
+  // Needs a current GL context. Packs each volume's ior and ior_grad (InputError naming its
+  // `source` when missing) into one RGBA32F 3D texture; `object_to_world` places it (thesis
+  // §6.3.1). A ray crosses the objects' boxes in the order it meets them, straight between them,
+  // and ends with the ground's hit test when there is a ground: the cost floor of the scene.
+  // InputError for none or more than kMaxObjects objects.
+  BareMarch(const gl::ShaderLibrary& shaders, const std::vector<BareObject>& objects, double step_voxels,
+            const std::optional<SceneGroundSpec>& ground = std::nullopt);
+  // One volume, no ground.
   BareMarch(const gl::ShaderLibrary& shaders, const Volume& volume, const glm::dmat4& object_to_world,
             double step_voxels, const std::string& source = "volume");
 
@@ -49,15 +68,20 @@ class BareMarch {
   // The total number of steps of every pixel's ray (the sum of render()'s alpha).
   double countSteps(const Camera& camera, glm::ivec2 size) const;
 
-  double stepLength() const { return step_; }  // in the volume's own units
-  int maxSteps() const { return max_steps_; }
+  double stepLength() const { return objects_.front().step; }  // the first volume's, in its own units
+  int maxSteps() const { return objects_.front().max_steps; }
+  int objectCount() const { return static_cast<int>(objects_.size()); }
 
  private:
-  GridSpec grid_;
-  glm::dmat4 object_to_world_;
-  double step_ = 0.0;
-  int max_steps_ = 0;
-  gl::Texture3D packed_;
+  struct Packed {
+    GridSpec grid;
+    glm::dmat4 object_to_world{1.0};
+    double step = 0.0;
+    int max_steps = 0;
+    gl::Texture3D texture;
+  };
+  std::vector<Packed> objects_;
+  std::optional<SceneGroundSpec> ground_;
   gl::Program program_;
   gl::FullscreenTriangle triangle_;
 };
@@ -76,7 +100,7 @@ struct BenchReport {
   std::string gl_summary;   // renderer, version and back end
   double step_voxels = 0.0;
   BenchFigures full;        // the viewer's renderer with the given settings
-  BenchFigures bare;        // BareMarch of the first object
+  BenchFigures bare;        // BareMarch of the whole scene
   double ratio_full_over_bare = 0.0;  // of the medians
 };
 

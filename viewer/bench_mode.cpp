@@ -19,8 +19,12 @@ int runBenchMode(const LoadedScene& scene, const RenderSettings& settings, const
   gl::GlContext context(context_options);
   gl::ShaderLibrary shaders;
   SceneRenderer renderer(shaders, scene, settings);
-  const LoadedObject& first = scene.objects.front();
-  BareMarch bare(shaders, first.volume, first.object_to_world, settings.step_voxels, first.source);
+  // The bare march of the whole scene: every object (up to BareMarch::kMaxObjects) and the ground.
+  std::vector<BareObject> bare_objects;
+  for (const LoadedObject& object : scene.objects) bare_objects.push_back({&object.volume, object.object_to_world, object.source});
+  if (bare_objects.size() > static_cast<std::size_t>(BareMarch::kMaxObjects))
+    bare_objects.resize(static_cast<std::size_t>(BareMarch::kMaxObjects));
+  BareMarch bare(shaders, bare_objects, settings.step_voxels, settings.ground ? scene.scene.ground : std::nullopt);
   BenchReport report =
       runBench([&] { renderer.draw(camera, options.size); }, bare, camera, options.size, options.frames);
   report.gl_renderer = context.info().renderer;
@@ -32,7 +36,9 @@ int runBenchMode(const LoadedScene& scene, const RenderSettings& settings, const
     j["scene"] = scene.source;
     j["objects"] = static_cast<int>(scene.objects.size());
     j["integrator"] = rayIntegratorName(settings.integrator);
-    j["bare_object"] = first.source;
+    j["bare_objects"] = bare.objectCount();
+    j["bare_ground"] = settings.ground && scene.scene.ground.has_value();
+    const LoadedObject& first = scene.objects.front();
     j["grid"] = {first.volume.grid.dims.x, first.volume.grid.dims.y, first.volume.grid.dims.z};
     writeFileAtomic(options.stats_path, j.dump(2) + "\n");
   }

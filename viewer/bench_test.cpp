@@ -7,7 +7,10 @@
 
 #include <cmath>
 
+#include "core/error.h"
 #include "gl/context.h"
+
+#include <glm/gtc/matrix_transform.hpp>
 
 namespace eik {
 namespace {
@@ -69,6 +72,43 @@ TEST(Bench, BareMarchBendsRaysTowardsHigherIndex) {
   const float dx = 2.0f * image.at(16, 16)[0] - 1.0f;
   EXPECT_NEAR(dx, 0.2f / 1.5f, 0.015f);
   EXPECT_NEAR(2.0f * image.at(16, 16)[1] - 1.0f, 0.0f, 1e-4f);
+}
+
+TEST(Bench, TheBareMarchOfASceneCrossesEveryObjectInTheOrderTheRayMeetsThem) {
+  gl::GlContext context;
+  gl::ShaderLibrary shaders;
+  // Two cubes of constant n one behind the other on the camera's axis, and a third beside them
+  // that the centre ray misses: straight rays, so each ray's steps are the sum of the boxes' own.
+  const Volume a = cube(1.5f, 0.0f), b = cube(1.3f, 0.0f), c = cube(1.2f, 0.0f);
+  const glm::dmat4 front(1.0), behind = glm::translate(glm::dmat4(1.0), glm::dvec3(0.0, 0.0, -2.0)),
+                   aside = glm::translate(glm::dmat4(1.0), glm::dvec3(3.0, 0.0, -1.0));
+  const Camera camera{{0.0, 0.0, 3.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 30.0};
+  const glm::ivec2 size(33, 33);
+  const double alone = BareMarch(shaders, a, front, 0.5).countSteps(camera, size) +
+                       BareMarch(shaders, b, behind, 0.5).countSteps(camera, size) +
+                       BareMarch(shaders, c, aside, 0.5).countSteps(camera, size);
+  for (const bool reversed : {false, true}) {
+    std::vector<BareObject> objects = {{&a, front, "a"}, {&b, behind, "b"}, {&c, aside, "c"}};
+    if (reversed) std::swap(objects.front(), objects.back());
+    const BareMarch scene(shaders, objects, 0.5);
+    EXPECT_EQ(scene.objectCount(), 3);
+    const Image image = scene.render(camera, size);
+    // The centre ray: 32 steps in each of the two cubes on the axis (as the one-cube test).
+    EXPECT_NEAR(image.at(16, 16)[3], 64.0f, 1.0f) << "reversed " << reversed;
+    // Every ray: the sum of the three boxes' steps, to a step where a ray grazes a box's edge.
+    EXPECT_NEAR(scene.countSteps(camera, size), alone, 0.002 * alone) << "reversed " << reversed;
+  }
+  // The ground: a ray going down towards it leaves reflected (its hit test).
+  SceneGroundSpec ground;
+  ground.point = {0.0, -1.0, 0.0};
+  const Camera above{{0.0, 2.0, 3.0}, {0.0, -1.0, 0.0}, {0.0, 1.0, 0.0}, 30.0};
+  const Image with_ground = BareMarch(shaders, {{&a, front, "a"}}, 0.5, ground).render(above, size);
+  const Image without = BareMarch(shaders, {{&a, front, "a"}}, 0.5).render(above, size);
+  EXPECT_GT(2.0f * with_ground.at(16, 32)[1] - 1.0f, 0.0f);  // bottom row, up after the ground
+  EXPECT_LT(2.0f * without.at(16, 32)[1] - 1.0f, 0.0f);      // still going down without it
+  // No objects, or more than the samplers it has.
+  EXPECT_THROW(BareMarch(shaders, std::vector<BareObject>{}, 0.5), InputError);
+  EXPECT_THROW(BareMarch(shaders, std::vector<BareObject>(9, BareObject{&a, front, "a"}), 0.5), InputError);
 }
 
 TEST(Bench, ReportFiguresAreConsistent) {
