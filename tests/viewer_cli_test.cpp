@@ -196,6 +196,26 @@ TEST(ViewerCli, RendersABakedSceneWithGroundSkyAndTwoObjects) {
   })");
   r = runProgram(VIEWER_EXE, {"scene.json", "--render", "scene.exr", "--quiet"}, dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.output;
+  // The same scene with an environment map beside it, named from the folder above: every path
+  // inside the scene is the scene folder's, and is resolved once (it used to be joined to the
+  // folder twice, "dir/dir/env.exr", and the render failed).
+  {
+    Image env;
+    env.width = 8;
+    env.height = 4;
+    env.channels = 3;
+    env.pixels.assign(8 * 4 * 3, 0.5f);
+    writeImage(dir / "env.exr", env);
+    std::string text = readFile(dir / "scene.json");
+    const std::string sky = R"("procedural": "sky")";
+    text.replace(text.find(sky), sky.size(), R"("file": "env.exr")");
+    writeFile(dir / "env_scene.json", text);
+    const std::filesystem::path relative = dir.path().filename() / "env_scene.json";
+    ProgramResult nested = runProgram(VIEWER_EXE, {relative.string(), "--render", (dir / "nested.png").string(),
+                                                   "--size", "16x12", "--quiet"},
+                                      dir.path().parent_path());
+    EXPECT_EQ(nested.exit_code, 0) << nested.output;
+  }
   Image image = readImage(dir / "scene.exr");
   ASSERT_EQ(image.width, 64);
   ASSERT_EQ(image.height, 48);

@@ -112,15 +112,19 @@ LoadedScene loadScene(const std::filesystem::path& input) {
   LoadedScene loaded;
   loaded.source = text;
   loaded.scene = readScene(input);
+  // Resolved paths are made absolute here, once: a relative one (a scene given as
+  // sub/SCENE.json) would be taken relative to the scene's folder again by whoever opens it.
   SceneEnvironmentSpec& environment = loaded.scene.environment;
-  if (!environment.file.empty()) environment.file = loaded.scene.resolve("environment.file", environment.file).string();
+  if (!environment.file.empty())
+    environment.file = std::filesystem::absolute(loaded.scene.resolve("environment.file", environment.file)).string();
   if (loaded.scene.objects.empty()) throw InputError(text, "objects", "the scene has no object");
   for (std::size_t i = 0; i < loaded.scene.objects.size(); ++i) {
     const SceneObjectSpec& spec = loaded.scene.objects[i];
     if (!(spec.scale > 0) || !std::isfinite(spec.scale))
       throw InputError(text, "objects[" + std::to_string(i) + "].scale", "must be a positive number");
     LoadedObject object;
-    object.source = loaded.scene.resolve("objects[" + std::to_string(i) + "].volume", spec.volume).string();
+    object.source =
+        std::filesystem::absolute(loaded.scene.resolve("objects[" + std::to_string(i) + "].volume", spec.volume)).string();
     object.volume = readVolume(object.source);
     requireOptics(object.volume, object.source);
     object.object_to_world = objectToWorld(spec);
