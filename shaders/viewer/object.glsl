@@ -45,8 +45,9 @@ struct March@ {
   float side;       // height above the ground at the last sample
   vec3 xPrev;       // position at the last sample
   int medium;       // sharp interfaces (HAS_INTERFACES): the material slot the ray is in, −1 air
-  vec4 dist;        // the slot distances fetched last (HAS_INTERFACES) ...
-  vec3 xDist;       // ... and where: a step reuses them at its start instead of fetching again
+  vec4 dist;        // the slot distances at x (HAS_INTERFACES), fetched where x last moved
+  vec3 groundHit;   // where the last step met the ground (world; the ground event)
+  vec3 uvwOpaque;   // where the ray met an opaque embedding (the opaque event)
 };
 
 // Radiance of an opaque embedding of diffuse albedo ρ at uvw: ρE/π with the baked irradiance E
@@ -184,7 +185,8 @@ March@ enterVolume@(Ray r, float cauchy) {
   vec3 d = normalize(mat3(toVolume) * r.d);
   m.x = (toVolume * vec4(r.x, 1.0)).xyz + d * (1e-3 * m.h);
   m.dist = volumeInterfaces((m.x - m.bmin) * m.invExtent);
-  m.xDist = m.x;
+  m.groundHit = vec3(0.0);
+  m.uvwOpaque = vec3(0.0);
   m.medium = materialAt@(m.dist);
   vec4 optics = refractiveIndex@((m.x - m.bmin) * m.invExtent, cauchy, m.medium);
   m.n = optics.r;
@@ -252,13 +254,13 @@ vec3 branchRadiance@(vec3 pVol, vec3 dVol) {
   return environmentRadiance(dw, uReflectionLod);
 }
 
-// The ray ends on the ground (GROUND) where the last step crossed it from above inside the volume
-// (checked before leaving the box, as the last step may do both): ρE/π there. True when it did.
-// With sharp interfaces the ground is met from the air only: inside a material the height is not
+// Whether the last step crossed the ground (GROUND) from above inside the volume, and where
+// (m.groundHit; checked before leaving the box, as the last step may do both); shadeGround@ ends
+// the ray there. With sharp interfaces the ground is met from the air only: inside a material the height is not
 // followed, so a face resting on the ground decides first (Fresnel, total internal reflection) and
 // the ray meets the ground once it has left the face downwards; the face is found to a fraction of
 // a voxel, a hair above or below the plane, which must not decide whether a reflection happens.
-bool hitGround@(inout Ray r, inout March@ m) {
+bool crossedGround@(inout March@ m) {
 #ifdef GROUND
 #ifdef HAS_INTERFACES
   if (m.medium >= 0) return false;
@@ -266,19 +268,23 @@ bool hitGround@(inout Ray r, inout March@ m) {
   float s = dot(m.x - m.groundPoint, m.groundNormal);
   if (m.side > 0.0 && s <= 0.0) {
     vec3 hit = mix(m.xPrev, m.x, m.side / (m.side - s));
-    vec3 hitWorld = (uObjVolToWorld[@] * vec4(hit, 1.0)).xyz;
-    if (onGround(hitWorld)) {
-      r.radiance += r.T * exp(-m.tau) * groundRadiance(hitWorld);
-      r.x = hitWorld;
-      r.done = true;
-      m.stopped = true;
-      return true;
-    }
+    m.groundHit = (uObjVolToWorld[@] * vec4(hit, 1.0)).xyz;
+    if (onGround(m.groundHit)) return true;
   }
   m.side = s;
   m.xPrev = m.x;
 #endif
   return false;
+}
+
+// The ray ends on the ground at m.groundHit: ρE/π there (GROUND).
+void shadeGround@(inout Ray r, inout March@ m) {
+#ifdef GROUND
+  r.radiance += r.T * exp(-m.tau) * groundRadiance(m.groundHit);
+  r.x = m.groundHit;
+  r.done = true;
+  m.stopped = true;
+#endif
 }
 
 // Whether the ray has left the box of the non-trivial region (empty-space skipping: outside it
@@ -304,6 +310,9 @@ bool reflectedAtSharpFace@(inout Ray r, inout March@ m) {
     if (R >= 1.0) {
       m.w = reflect(m.w, outward);
       m.x = m.xStepStart;
+#ifdef HAS_INTERFACES
+      m.dist = volumeInterfaces((m.x - m.bmin) * m.invExtent);
+#endif
       return true;
     }
 #ifdef FRESNEL
@@ -333,26 +342,35 @@ bool skipHomogeneousBrick@(inout March@ m, vec3 uvw) {
     m.tau += volumeSigmaA(uvw) * L;  // Beer–Lambert, σa constant here
 #endif
     m.x += dir * L;
+#ifdef HAS_INTERFACES
+    m.dist = volumeInterfaces((m.x - m.bmin) * m.invExtent);
+#endif
     return true;
   }
 #endif
   return false;
 }
 
-// An opaque embedding stops the ray: ρE/π + ambient, with the albedo interpolated with the
-// indicator, divided by it (premultiplied at the edge). True when it did.
-bool hitOpaque@(inout Ray r, inout March@ m, vec3 uvw) {
+// Whether an opaque embedding is at uvw (HAS_OPAQUE): its indicator over ½.
+bool metOpaque@(inout March@ m, vec3 uvw) {
 #ifdef HAS_OPAQUE
-  vec4 opaque = volumeOpaque(uvw);
-  if (opaque.a > 0.5) {
-    r.radiance += r.T * exp(-m.tau) * opaqueRadiance@(opaque.rgb / opaque.a, uvw);
-    r.x = (uObjVolToWorld[@] * vec4(m.x, 1.0)).xyz;
-    r.done = true;
-    m.stopped = true;
-    return true;
-  }
-#endif
+  m.uvwOpaque = uvw;
+  return volumeOpaque(uvw).a > 0.5;
+#else
   return false;
+#endif
+}
+
+// The opaque embedding stops the ray: ρE/π + ambient, with the albedo interpolated with the
+// indicator, divided by it (premultiplied at the edge).
+void shadeOpaque@(inout Ray r, inout March@ m) {
+#ifdef HAS_OPAQUE
+  vec4 opaque = volumeOpaque(m.uvwOpaque);
+  r.radiance += r.T * exp(-m.tau) * opaqueRadiance@(opaque.rgb / opaque.a, m.uvwOpaque);
+  r.x = (uObjVolToWorld[@] * vec4(m.x, 1.0)).xyz;
+  r.done = true;
+  m.stopped = true;
+#endif
 }
 
 // Follows the boundary layer at this sample (∇n = grad, |∇n|² = grad2; quiet: below a 16th of the
@@ -416,7 +434,7 @@ void inScatter@(inout Ray r, March@ m, vec3 uvw, float hs) {
 float stepLength@(March@ m, vec3 uvw, float grad2) {
   bool quiet = grad2 <= m.quiet2;
 #ifdef HAS_INTERFACES
-  vec4 d = abs(all(equal(m.x, m.xDist)) ? m.dist : volumeInterfaces(uvw));
+  vec4 d = abs(m.dist);  // at m.x
   float nearest = min(min(d.x, d.y), min(d.z, d.w));
   quiet = quiet && nearest > 4.0 * m.h;
 #endif
@@ -452,8 +470,19 @@ void stepRay@(inout March@ m, vec3 grad, float hs, float cauchy) {
 #endif
 }
 
-// A sharp interface crossed by the last step (HAS_INTERFACES): the step's chord from xStepStart
-// to x is cut where the first slot distance that changed sign is zero (linear interpolation, one
+// Whether the last step changed the material (HAS_INTERFACES): the slot distances at its end, the
+// one fetch of most steps.
+bool materialChanged@(inout March@ m) {
+#ifdef HAS_INTERFACES
+  m.dist = volumeInterfaces((m.x - m.bmin) * m.invExtent);
+  return materialAt@(m.dist) != m.medium;
+#else
+  return false;
+#endif
+}
+
+// The sharp interface the last step crossed (HAS_INTERFACES; materialChanged@): its chord from
+// xStepStart to x is cut where the first slot distance that changed sign is zero (linear interpolation, one
 // regula falsi refinement), and there, with the normal ∇d of that slot and n on both sides:
 // into an opaque material the ray stops and sees its surface (ρE/π); past the critical angle it
 // reflects totally; else the exact Fresnel R (corrected Eq. 3.6) splits it between the mirrored
@@ -461,11 +490,8 @@ void stepRay@(inout March@ m, vec3 grad, float hs, float cauchy) {
 bool crossInterface@(inout Ray r, inout March@ m, float cauchy) {
 #ifdef HAS_INTERFACES
   vec3 x0 = m.xStepStart, x1 = m.x;
-  vec4 d1 = volumeInterfaces((x1 - m.bmin) * m.invExtent);
-  m.dist = d1;
-  m.xDist = x1;
+  vec4 d1 = m.dist;
   int next = materialAt@(d1);
-  if (next == m.medium) return false;  // most steps: one fetch
   vec4 d0 = volumeInterfaces((x0 - m.bmin) * m.invExtent);
   // Where each slot's distance changes sign along the chord; then, in order along it, the first
   // surface that changes the material (an outer slot's surface inside an inner one changes nothing).
@@ -505,6 +531,7 @@ bool crossInterface@(inout Ray r, inout March@ m, float cauchy) {
   }
   vec3 p = mix(x0, x1, best);
   m.x = p;
+  m.dist = volumeInterfaces((p - m.bmin) * m.invExtent);
   vec3 e = 0.5 / m.invExtent / vec3(textureSize(INTERFACES_SAMPLER, 0));  // half a voxel
   vec3 normal = vec3(
       volumeInterfaces((p + vec3(e.x, 0, 0) - m.bmin) * m.invExtent)[slot] - volumeInterfaces((p - vec3(e.x, 0, 0) - m.bmin) * m.invExtent)[slot],
@@ -593,29 +620,38 @@ void leaveVolume@(inout Ray r, inout March@ m) {
   r.entered = true;
 }
 
-// The ray through this object: Eq. 5.10 gathered along the curved ray of Eq. 5.11/5.12.
+// The ray through this object: Eq. 5.10 gathered along the curved ray of Eq. 5.11/5.12. Runs of
+// ordinary steps, each run ended by an event (EVENT_*) that is handled after it, outside the step
+// loop; every pass takes at least one step, so uObjMaxSteps bounds both loops.
 void march@(inout Ray r, float cauchy) {
   March@ m = enterVolume@(r, cauchy);
   enterSharpFace@(r, m);
-  for (int i = 0; i < uObjMaxSteps[@]; ++i) {
-    if (hitGround@(r, m)) break;
-    if (leftActiveRegion@(m)) {
-      if (reflectedAtSharpFace@(r, m)) continue;  // total internal reflection: the step again
-      break;
+  int steps = 0;
+  for (int pass = 0; pass < uObjMaxSteps[@] && steps < uObjMaxSteps[@]; ++pass) {
+    int event = EVENT_NONE;
+    for (; steps < uObjMaxSteps[@]; ++steps) {
+      if (crossedGround@(m)) { event = EVENT_GROUND; break; }
+      if (leftActiveRegion@(m)) { event = EVENT_LEFT; break; }
+      vec3 uvw = (m.x - m.bmin) * m.invExtent;
+      if (skipHomogeneousBrick@(m, uvw)) continue;
+      vec4 optics = refractiveIndex@(uvw, cauchy, m.medium);
+      m.n = optics.r;
+      vec3 grad = optics.gba;
+      float grad2 = dot(grad, grad);
+      float hs = stepLength@(m, uvw, grad2);
+      if (metOpaque@(m, uvw)) { event = EVENT_OPAQUE; break; }
+      followBoundaryLayer@(r, m, grad, grad2, grad2 <= m.quiet2, uvw);
+      gatherMedium@(r, m, uvw, hs);
+      stepRay@(m, grad, hs, cauchy);
+      if (materialChanged@(m)) { event = EVENT_CROSSING; break; }
+      if (absorbed@(r, m)) break;
     }
-    vec3 uvw = (m.x - m.bmin) * m.invExtent;
-    if (skipHomogeneousBrick@(m, uvw)) continue;
-    vec4 optics = refractiveIndex@(uvw, cauchy, m.medium);
-    m.n = optics.r;
-    vec3 grad = optics.gba;
-    float grad2 = dot(grad, grad);
-    float hs = stepLength@(m, uvw, grad2);
-    if (hitOpaque@(r, m, uvw)) break;
-    followBoundaryLayer@(r, m, grad, grad2, grad2 <= m.quiet2, uvw);
-    gatherMedium@(r, m, uvw, hs);
-    stepRay@(m, grad, hs, cauchy);
-    if (crossInterface@(r, m, cauchy)) break;
-    if (absorbed@(r, m)) break;
+    if (event == EVENT_NONE) break;
+    if (event == EVENT_GROUND) { shadeGround@(r, m); break; }
+    if (event == EVENT_OPAQUE) { shadeOpaque@(r, m); break; }
+    ++steps;  // the step that ended the run, or the one a reflection takes again
+    if (event == EVENT_LEFT && !reflectedAtSharpFace@(r, m)) break;  // total internal reflection: on
+    if (event == EVENT_CROSSING && (crossInterface@(r, m, cauchy) || absorbed@(r, m))) break;
   }
   leaveVolume@(r, m);
 }

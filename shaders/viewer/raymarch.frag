@@ -116,6 +116,15 @@ vec3 groundRadiance(vec3 xw);  // after the objects: it asks each one for its ba
 const float kGroundBlendVoxels = 3.0;  // the bake fades into the unoccluded light over this margin
 #endif
 
+// What ends a run of ordinary steps in an object's march: the ray met something costly to handle.
+// llvmpipe runs every branch of a loop body in every SIMD lane, taken or not, so the handlers
+// run outside the step loop, once per event, instead of (masked) at every step.
+const int EVENT_NONE = 0;      // out of steps, absorbed, or stopped
+const int EVENT_GROUND = 1;    // the last step crossed the ground from above
+const int EVENT_LEFT = 2;      // the ray is out of the active region (or the box)
+const int EVENT_CROSSING = 3;  // the last step changed the material (HAS_INTERFACES)
+const int EVENT_OPAQUE = 4;    // an opaque embedding is here (HAS_OPAQUE)
+
 // Every object's march (march0, march1, ...): viewer/raymarch_shader.cpp puts one instance of
 // viewer/object.glsl per object in place of the next line.
 // @OBJECTS@
