@@ -118,14 +118,16 @@ int materialAt@(vec4 d) {
 // material). ior and ior_grad share one RGBA texture (SceneRenderer checks): one fetch for both.
 vec4 refractiveIndex@(vec3 uvw, float cauchy, int medium) {
 #ifdef HAS_INTERFACES
-  if (medium < 0) return vec4(1.0, 0.0, 0.0, 0.0);
-  if (SLOT_GRADED[medium] < 0.5) {
 #ifdef DISPERSION
-    return vec4(SLOT_IOR[medium] + SLOT_DISPERSION[medium] * cauchy, 0.0, 0.0, 0.0);
+  float slotN = medium < 0 ? 1.0 : SLOT_IOR[max(medium, 0)] + SLOT_DISPERSION[max(medium, 0)] * cauchy;
 #else
-    return vec4(SLOT_IOR[medium], 0.0, 0.0, 0.0);
+  float slotN = medium < 0 ? 1.0 : SLOT_IOR[max(medium, 0)];
 #endif
-  }
+#ifdef CONSTANT_SLOTS
+  return vec4(slotN, 0.0, 0.0, 0.0);  // no graded slot: no fetch (llvmpipe would fetch, masked)
+#else
+  if (medium < 0 || SLOT_GRADED[medium] < 0.5) return vec4(slotN, 0.0, 0.0, 0.0);
+#endif
 #endif
   vec4 optics = texture(IOR_SAMPLER, uvw);  // ior (r), ior_grad (gba)
 #if defined(DISPERSION) && defined(HAS_DISPERSION)
@@ -573,15 +575,15 @@ bool crossInterface@(inout Ray r, inout March@ m, float cauchy) {
   // direction (outside the object exactly; for a reflection inside it, an approximation of the
   // light that would come back through the object).
   float R = fresnelUnpolarised(n1, n2, cosI, sqrt(1.0 - sin2T));
-  vec3 weight = r.T * exp(-m.tau);
-  if (R > 0.5) {
-    r.radiance += weight * (1.0 - R) * branchRadiance@(p, refracted);
+  bool reflects = R > 0.5;
+  // The branch not followed, looked up once (llvmpipe would run both calls of an if/else).
+  r.radiance += r.T * exp(-m.tau) * (reflects ? 1.0 - R : R) * branchRadiance@(p, reflects ? refracted : mirrored);
+  if (reflects) {
     r.T *= R;
     m.w = mirrored * n1;
     m.n = n1;
     return false;
   }
-  r.radiance += weight * R * branchRadiance@(p, mirrored);
   r.T *= 1.0 - R;
 #endif
   m.w = refracted * n2;
