@@ -78,7 +78,7 @@ int run(int argc, char** argv) {
   app.add_flag("--no-emission", no_emission, "leave out emission");
   app.add_flag("--no-dispersion", no_dispersion, "one ray for R, G and B even where a dispersion field exists");
   app.add_flag("--no-ground", no_ground, "leave out the scene's ground plane");
-  app.add_flag("--no-skip", no_skip, "march the whole box of every volume (no empty-space skipping)");
+  app.add_flag("--no-skip", no_skip, "no empty-space skipping: march the whole box of every volume, and at most a voxel a step between sharp surfaces");
   app.add_flag("--bricks", bricks, "cross homogeneous 4x4x4-voxel bricks in one step (off: on llvmpipe it rarely pays)");
   app.add_option("--exposure", exposure, "exposure in EV for PNG output (default: the scene's render.exposure, else 0)");
   app.add_option("--tonemap", tonemap_text, "aces | reinhard | linear, for PNG output (default: the scene's render.tonemap, else aces)");

@@ -101,6 +101,7 @@ gl::ShaderDefines raymarchDefines(const RenderSettings& settings, const Raymarch
   if (!settings.refraction) d.emplace_back("NO_REFRACTION", "1");
   if (settings.integrator == RayIntegrator::RK4) d.emplace_back("RK4", "1");
   if (settings.homogeneous_bricks) d.emplace_back("SKIP_HOMOGENEOUS", "1");
+  if (settings.skip_empty_space) d.emplace_back("SKIP_TO_SURFACES", "1");
   if (settings.output == RenderOutput::ExitPosition) d.emplace_back("OUTPUT_EXIT_POSITION", "1");
   else if (settings.output == RenderOutput::ExitDirection) d.emplace_back("OUTPUT_EXIT_DIRECTION", "1");
   else if (settings.dispersion && scene.dispersive) d.emplace_back("DISPERSION", "1");

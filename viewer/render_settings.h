@@ -34,7 +34,10 @@ struct RenderSettings {
   bool emission = true;      // L_e
   bool dispersion = true;    // R, G, B follow their own rays where a `dispersion` field exists
   bool ground = true;        // the scene's ground plane, if it has one
-  bool skip_empty_space = true;  // march only the box of a volume's non-trivial region (straight elsewhere)
+  // March only the box of a volume's non-trivial region (straight elsewhere), and between sharp
+  // surfaces of constant n step as far as the distance to the next surface allows (object.glsl
+  // stepLength@).
+  bool skip_empty_space = true;
   // Cross bricks of 4³ voxels where the medium is homogeneous (n, σa constant, nothing else) in one
   // step. Off by default: on llvmpipe the extra brick fetch a step cost more than it saved in the
   // scenes measured (64³ glass sphere 1.11× → 1.16× the bare march; 32³ absorbing one 2.2× → 2.8×).

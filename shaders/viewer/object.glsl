@@ -432,12 +432,23 @@ void inScatter@(inout Ray r, March@ m, vec3 uvw, float hs) {
 // The step: far from any boundary (|∇n| under a 16th of the boundary threshold) it doubles; the
 // next boundary layer is still resolved, and the renormalisation across ∇n keeps the direction
 // after it exact (Snell's law in a layered medium). With sharp interfaces it doubles only more
-// than two voxels from every surface, so that no thin wall is stepped over.
+// than two voxels from every surface, so that no thin wall is stepped over. With sharp
+// interfaces between materials of constant n, and nothing along the ray that needs samples
+// (emission, scattering), the ray is straight up to the next surface, so the step goes as far as
+// the distance field allows (sphere tracing): the trilinear interpolant of distances that change
+// by at most one per unit length changes by at most √3 per unit length (|∂d/∂x_i| ≤ 1 on every
+// axis), so no surface lies within nearest/√3 (the field is clamped to ±4 voxels: steps up to
+// 2.3 voxels; SKIP_TO_SURFACES, the viewer's empty-space skipping). σa is taken at the step's
+// start, constant within a material.
 float stepLength@(March@ m, vec3 uvw, float grad2) {
   bool quiet = grad2 <= m.quiet2;
 #ifdef HAS_INTERFACES
   vec4 d = abs(m.dist);  // at m.x
   float nearest = min(min(d.x, d.y), min(d.z, d.w));
+#if defined(SKIP_TO_SURFACES) && defined(CONSTANT_SLOTS) && !(defined(EMISSION) && defined(HAS_EMISSION)) && \
+    !(defined(SCATTERING) && defined(HAS_SCATTER))
+  return max(m.h, nearest * 0.57735);
+#endif
   quiet = quiet && nearest > 4.0 * m.h;
 #endif
   return quiet ? 2.0 * m.h : m.h;
@@ -469,6 +480,22 @@ void stepRay@(inout March@ m, vec3 grad, float hs, float cauchy) {
 #else
   m.x += hs * (m.w + 0.5 * hs * grad) / m.n;  // Eq. 5.11, w at mid-step
   m.w += hs * grad;                            // Eq. 5.12
+#endif
+}
+
+// A ray reflected at the interface point p goes on from a tenth of a step back on the side it
+// came from (facing: the normal towards that side), if that point is in the ray's material (at a
+// thin wall or an edge it may not be: then from p). From p itself a grazing reflected ray met the
+// surface again at its next step, within the distance field's interpolation error, and reflected
+// again at every step until the step budget ran out.
+void stayOnIncidentSide@(inout March@ m, vec3 p, vec3 facing) {
+#ifdef HAS_INTERFACES
+  vec3 x = p + facing * (0.1 * m.h);
+  vec4 d = volumeInterfaces((x - m.bmin) * m.invExtent);
+  if (materialAt@(d) == m.medium) {
+    m.x = x;
+    m.dist = d;
+  }
 #endif
 }
 
@@ -564,6 +591,7 @@ bool crossInterface@(inout Ray r, inout March@ m, float cauchy) {
   if (sin2T >= 1.0) {  // total internal reflection
     m.w = reflect(d, facing) * n1;
     m.n = n1;
+    stayOnIncidentSide@(m, p, facing);
     return false;
   }
   vec3 refracted = refract(d, facing, n1 / n2);
@@ -582,6 +610,7 @@ bool crossInterface@(inout Ray r, inout March@ m, float cauchy) {
     r.T *= R;
     m.w = mirrored * n1;
     m.n = n1;
+    stayOnIncidentSide@(m, p, facing);
     return false;
   }
   r.T *= 1.0 - R;
@@ -624,12 +653,14 @@ void leaveVolume@(inout Ray r, inout March@ m) {
 
 // The ray through this object: Eq. 5.10 gathered along the curved ray of Eq. 5.11/5.12. Runs of
 // ordinary steps, each run ended by an event (EVENT_*) that is handled after it, outside the step
-// loop; every pass takes at least one step, so uObjMaxSteps bounds both loops.
+// loop. A ray that meets more than kMaxEventsPerObject events in one object (light trapped by
+// total internal reflection, or a ray caught on a surface) leaves it where it is, as one out of
+// steps does.
 void march@(inout Ray r, float cauchy) {
   March@ m = enterVolume@(r, cauchy);
   enterSharpFace@(r, m);
   int steps = 0;
-  for (int pass = 0; pass < uObjMaxSteps[@] && steps < uObjMaxSteps[@]; ++pass) {
+  for (int pass = 0; pass < kMaxEventsPerObject && steps < uObjMaxSteps[@]; ++pass) {
     int event = EVENT_NONE;
     for (; steps < uObjMaxSteps[@]; ++steps) {
       if (crossedGround@(m)) { event = EVENT_GROUND; break; }
