@@ -60,25 +60,28 @@ vec3 opaqueRadiance@(vec3 albedo, vec3 uvw) {
 // ground = irradiance · max(0, N·(−l)) with the baked light direction l (thesis §3.2.2). Returns
 // the weight of the bake against the unoccluded light: 0 outside the box, rising to 1 over the
 // outer kGroundBlendVoxels, so the edge of the baked region leaves no seam.
+// (The fetches sit in an if-block, not after an early return: llvmpipe skips an if-block no lane
+// takes, but runs the code after a return for every lane, masked.)
 #ifdef GROUND
 float bakedGroundIrradiance@(vec3 xw, out vec3 E) {
   E = vec3(0.0);
+  float weight = 0.0;
 #if defined(HAS_IRRADIANCE) && defined(HAS_LIGHT_DIR)
   vec3 x = (uObjWorldToVol[@] * vec4(xw, 1.0)).xyz;
   vec3 uvw = (x - uObjBoundsMin[@]) / (uObjBoundsMax[@] - uObjBoundsMin[@]);
   // Distance to each face, in voxels, past the outermost voxel centres (half a voxel in).
   vec3 fromFace = min(uvw, 1.0 - uvw) / (2.0 * uObjHalfVoxel[@]) - 0.5;
-  if (min(min(fromFace.x, fromFace.y), fromFace.z) <= 0.0) return 0.0;
-  vec3 normal = normalize(mat3(uObjWorldToVol[@]) * uGroundNormal);
-  vec3 l = volumeLightDir(uvw);
-  E = volumeIrradiance(uvw) * max(0.0, -dot(normal, l));
-  // The same distances measured within the ground plane: a face parallel to the ground never
-  // meets it (a box's floor just under the ground must not fade the bake).
-  vec3 inPlane = fromFace / max(sqrt(max(1.0 - normal * normal, 0.0)), 1e-3);
-  return clamp(min(min(inPlane.x, inPlane.y), inPlane.z) / kGroundBlendVoxels, 0.0, 1.0);
-#else
-  return 0.0;
+  if (min(min(fromFace.x, fromFace.y), fromFace.z) > 0.0) {
+    vec3 normal = normalize(mat3(uObjWorldToVol[@]) * uGroundNormal);
+    vec3 l = volumeLightDir(uvw);
+    E = volumeIrradiance(uvw) * max(0.0, -dot(normal, l));
+    // The same distances measured within the ground plane: a face parallel to the ground never
+    // meets it (a box's floor just under the ground must not fade the bake).
+    vec3 inPlane = fromFace / max(sqrt(max(1.0 - normal * normal, 0.0)), 1e-3);
+    weight = clamp(min(min(inPlane.x, inPlane.y), inPlane.z) / kGroundBlendVoxels, 0.0, 1.0);
+  }
 #endif
+  return weight;
 }
 #endif
 
@@ -88,17 +91,18 @@ float bakedGroundIrradiance@(vec3 xw, out vec3 E) {
 #ifdef GROUND
 bool receiverChange@(vec3 xw, out vec3 change) {
   change = vec3(0.0);
+  bool covered = false;
 #ifdef HAS_RECEIVER
   vec3 x = (uObjWorldToVol[@] * vec4(xw, 1.0)).xyz;
   vec3 q = x - uObjRecvPoint[@];
   vec2 st = (vec2(dot(q, uObjRecvU[@]), dot(q, uObjRecvV[@])) - uObjRecvOrigin[@]) / uObjRecvSize[@];
-  if (any(lessThan(st, vec2(0.0))) || any(greaterThan(st, vec2(1.0)))) return false;
-  vec3 normal = cross(uObjRecvU[@], uObjRecvV[@]);
-  change = texture(uO@Receiver, st).rgb - lightIrradiance(uObjRecvLightPos[@], uObjRecvLightPower[@], x, normal);
-  return true;
-#else
-  return false;
+  covered = all(greaterThanEqual(st, vec2(0.0))) && all(lessThanEqual(st, vec2(1.0)));
+  if (covered) {
+    vec3 normal = cross(uObjRecvU[@], uObjRecvV[@]);
+    change = texture(uO@Receiver, st).rgb - lightIrradiance(uObjRecvLightPos[@], uObjRecvLightPower[@], x, normal);
+  }
 #endif
+  return covered;
 }
 #endif
 
@@ -279,10 +283,11 @@ bool crossedGround@(inout March@ m) {
   return false;
 }
 
-// The ray ends on the ground at m.groundHit: ρE/π there (GROUND).
+// The ray ends on the ground at m.groundHit: ρE/π there (GROUND), added by trace.
 void shadeGround@(inout Ray r, inout March@ m) {
 #ifdef GROUND
-  r.radiance += r.T * exp(-m.tau) * groundRadiance(m.groundHit);
+  r.grounded = true;
+  r.groundWeight = r.T * exp(-m.tau);
   r.x = m.groundHit;
   r.done = true;
   m.stopped = true;

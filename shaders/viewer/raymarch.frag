@@ -75,6 +75,8 @@ struct Ray {
   vec3 radiance;  // gathered so far
   vec3 T;         // transmittance so far (Beer–Lambert × Fresnel)
   bool done;      // ended on an opaque surface, the ground, or absorbed
+  bool grounded;  // ended on the ground at x: trace adds groundWeight·groundRadiance(x) once,
+  vec3 groundWeight;  // after the objects (one place in the program that shades the ground)
   bool entered;   // went through a volume
   vec3 exitX;     // world position where it last left a volume
 };
@@ -186,17 +188,22 @@ void trace(inout Ray r, float cauchy) {
     float tGround = groundDistance(r.x, r.d);
     if (tGround < tBest) {
       r.x += tGround * r.d;
-      r.radiance += r.T * groundRadiance(r.x);
+      r.grounded = true;
+      r.groundWeight = r.T;
       r.done = true;
-      return;
     }
 #endif
-    if (next < 0) return;
+    if (r.done || next < 0) break;
     r.x += tBest * r.d;
     marchObject(next, r, cauchy);
-    if (r.done) return;
+    if (r.done) break;
     last = next;
   }
+#ifdef GROUND
+  // The ground's shading, in one place for every way the ray can end on it (llvmpipe's cost grew
+  // with each place it was written out: 25 % of the museum's frame).
+  if (r.grounded) r.radiance += r.groundWeight * groundRadiance(r.x);
+#endif
 }
 
 Ray primaryRay() {
@@ -207,6 +214,8 @@ Ray primaryRay() {
   r.radiance = vec3(0.0);
   r.T = vec3(1.0);
   r.done = false;
+  r.grounded = false;
+  r.groundWeight = vec3(0.0);
   r.entered = false;
   r.exitX = uEye;
   return r;
