@@ -56,8 +56,9 @@ vec3 opaqueRadiance@(vec3 albedo, vec3 uvw) {
   return albedo * (volumeIrradiance(uvw) * INV_PI + uAmbientRadiance);
 }
 
-// The baked irradiance on the ground at world point xw, if it lies inside this volume: E on the
-// ground = irradiance · max(0, N·(−l)) with the baked light direction l (thesis §3.2.2). Returns
+// The baked irradiance on the ground at world point xw, if it lies inside this volume and the
+// volume has no receiver map (whose change, receiverChange@, is the ground's light where it has
+// one): E on the ground = irradiance · max(0, N·(−l)) with the baked light direction l (§3.2.2). Returns
 // the weight of the bake against the unoccluded light: 0 outside the box, rising to 1 over the
 // outer kGroundBlendVoxels, so the edge of the baked region leaves no seam.
 // (The fetches sit in an if-block, not after an early return: llvmpipe skips an if-block no lane
@@ -66,7 +67,7 @@ vec3 opaqueRadiance@(vec3 albedo, vec3 uvw) {
 float bakedGroundIrradiance@(vec3 xw, out vec3 E) {
   E = vec3(0.0);
   float weight = 0.0;
-#if defined(HAS_IRRADIANCE) && defined(HAS_LIGHT_DIR)
+#if defined(HAS_IRRADIANCE) && defined(HAS_LIGHT_DIR) && !defined(HAS_RECEIVER)
   vec3 x = (uObjWorldToVol[@] * vec4(xw, 1.0)).xyz;
   vec3 uvw = (x - uObjBoundsMin[@]) / (uObjBoundsMax[@] - uObjBoundsMin[@]);
   // Distance to each face, in voxels, past the outermost voxel centres (half a voxel in).
