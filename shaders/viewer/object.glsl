@@ -505,6 +505,14 @@ void stayOnIncidentSide@(inout March@ m, vec3 p, vec3 facing) {
 #endif
 }
 
+// A ray in a material of constant n whose Cauchy B is not 0 takes a path that depends on λ
+// (DISPERSION: red and blue then follow their own rays; raymarch.frag main).
+void markDispersed@(inout Ray r, int medium) {
+#if defined(HAS_INTERFACES) && defined(CONSTANT_SLOTS)
+  if (medium >= 0 && SLOT_DISPERSION[max(medium, 0)] != 0.0) r.dispersed = true;
+#endif
+}
+
 // Whether the last step changed the material (HAS_INTERFACES): the slot distances at its end, the
 // one fetch of most steps.
 bool materialChanged@(inout March@ m) {
@@ -564,6 +572,7 @@ bool crossInterface@(inout Ray r, inout March@ m, float cauchy) {
     slot = m.medium >= 0 ? m.medium : next;
     entered = next;
   }
+  markDispersed@(r, entered);  // Fresnel at its surface depends on λ too, whichever way the ray goes
   vec3 p = mix(x0, x1, best);
   m.x = p;
   m.dist = volumeInterfaces((p - m.bmin) * m.invExtent);
@@ -663,7 +672,11 @@ void leaveVolume@(inout Ray r, inout March@ m) {
 // total internal reflection, or a ray caught on a surface) leaves it where it is, as one out of
 // steps does.
 void march@(inout Ray r, float cauchy) {
+#if defined(HAS_DISPERSION) && !defined(CONSTANT_SLOTS)
+  r.dispersed = true;  // n(λ) may vary anywhere in the box
+#endif
   March@ m = enterVolume@(r, cauchy);
+  markDispersed@(r, m.medium);
   enterSharpFace@(r, m);
   int steps = 0;
   for (int pass = 0; pass < kMaxEventsPerObject && steps < uObjMaxSteps[@]; ++pass) {

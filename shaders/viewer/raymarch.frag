@@ -78,6 +78,7 @@ struct Ray {
   bool grounded;  // ended on the ground at x: trace adds groundWeight·groundRadiance(x) once,
   vec3 groundWeight;  // after the objects (one place in the program that shades the ground)
   bool entered;   // went through a volume
+  bool dispersed; // went through a volume with a dispersion field (DISPERSION: its path depends on λ)
   vec3 exitX;     // world position where it last left a volume
 };
 
@@ -217,6 +218,7 @@ Ray primaryRay() {
   r.grounded = false;
   r.groundWeight = vec3(0.0);
   r.entered = false;
+  r.dispersed = false;
   r.exitX = uEye;
   return r;
 }
@@ -242,15 +244,20 @@ void main() {
 #endif
 #elif defined(DISPERSION)
   // Cauchy terms 1/λ² − 1/λ_d² (µm⁻²) of the three channels, λ_d = 0.5876 µm (docs/volume-format.md).
+  // Green's ray first; red's and blue's only where it went through a dispersive volume, since
+  // elsewhere all three take the same path and green's RGB is each channel's own.
   const vec3 lambda = vec3(0.61, 0.55, 0.465);
   vec3 cauchy = 1.0 / (lambda * lambda) - vec3(1.0 / (0.5876 * 0.5876));
-  vec3 colour;
-  for (int c = 0; c < 3; ++c) {
-    Ray r = primaryRay();
-    trace(r, cauchy[c]);
-    colour[c] = finish(r)[c];
+  Ray green = primaryRay();
+  trace(green, cauchy[1]);
+  Ray red = green, blue = green;
+  if (green.dispersed) {
+    red = primaryRay();
+    trace(red, cauchy[0]);
+    blue = primaryRay();
+    trace(blue, cauchy[2]);
   }
-  outColor = vec4(colour, 1.0);
+  outColor = vec4(finish(red).r, finish(green).g, finish(blue).b, 1.0);  // uniform control flow
 #else
   Ray r = primaryRay();
   trace(r, 0.0);
