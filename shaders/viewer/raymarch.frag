@@ -120,8 +120,9 @@ const float kGroundBlendVoxels = 3.0;  // the bake fades into the unoccluded lig
 #endif
 
 // What ends a run of ordinary steps in an object's march: the ray met something costly to handle.
-// llvmpipe runs every branch of a loop body in every SIMD lane, taken or not, so the handlers
-// run outside the step loop, once per event, instead of (masked) at every step.
+// The handlers run after the step loop, once per event. Inside it they were the tail of a step
+// that most lanes had left by an early return, and llvmpipe (which skips an if-block no lane of
+// its 8-wide vector takes) runs such a tail for every lane, masked: at every step of every ray.
 const int EVENT_NONE = 0;      // out of steps, absorbed, or stopped
 const int EVENT_GROUND = 1;    // the last step crossed the ground from above
 const int EVENT_LEFT = 2;      // the ray is out of the active region (or the box)
