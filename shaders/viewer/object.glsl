@@ -58,11 +58,10 @@ vec3 opaqueRadiance@(vec3 albedo, vec3 uvw) {
 
 // The baked irradiance on the ground at world point xw, if it lies inside this volume and the
 // volume has no receiver map (whose change, receiverChange@, is the ground's light where it has
-// one): E on the ground = irradiance · max(0, N·(−l)) with the baked light direction l (§3.2.2). Returns
+// one): E on the ground = irradiance · max(0, N·(−l)) with the baked light direction l
+// (thesis §3.2.2). Returns
 // the weight of the bake against the unoccluded light: 0 outside the box, rising to 1 over the
 // outer kGroundBlendVoxels, so the edge of the baked region leaves no seam.
-// (The fetches sit in an if-block, not after an early return: llvmpipe skips an if-block no lane
-// takes, but runs the code after a return for every lane, masked.)
 #ifdef GROUND
 float bakedGroundIrradiance@(vec3 xw, out vec3 E) {
   E = vec3(0.0);
