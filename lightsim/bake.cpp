@@ -99,13 +99,32 @@ void applyBake(Volume& volume, const BakeResult& result, const LightSpec& light)
     if (f.components != 3 || f.data.size() != n * 3)
       throw std::invalid_argument(std::string("applyBake: ") + name + " does not match the volume's grid");
   };
-  check(result.irradiance, "irradiance");
-  check(result.light_dir, "light_dir");
-  volume.fields["irradiance"] = result.irradiance;
-  volume.fields["light_dir"] = result.light_dir;
+  if (result.irradiance.data.empty() && result.light_dir.data.empty()) {
+    // A bake without volume deposits: none of an earlier bake's fields may stay behind.
+    volume.fields.erase("irradiance");
+    volume.fields.erase("light_dir");
+  } else {
+    check(result.irradiance, "irradiance");
+    check(result.light_dir, "light_dir");
+    volume.fields["irradiance"] = result.irradiance;
+    volume.fields["light_dir"] = result.light_dir;
+  }
   volume.receivers = result.receivers;
   volume.metadata["light"] = light.toJson();
   volume.metadata["bake_stats"] = result.stats.toJson();
+}
+
+bool viewerReadsVolumeLight(const Volume& volume, bool receiver_map) {
+  if (!receiver_map) return true;
+  // Any voxel whose component `channel` of `name` is non-zero.
+  auto anyNonZero = [&](const char* name, int channel) {
+    const Field* f = volume.find(name);
+    if (!f || channel >= f->components) return false;
+    for (std::size_t i = static_cast<std::size_t>(channel); i < f->data.size(); i += static_cast<std::size_t>(f->components))
+      if (f->data[i] != 0.0f) return true;
+    return false;
+  };
+  return anyNonZero("scatter", 0) || anyNonZero("opaque", 3);
 }
 
 nlohmann::json bakeOptionsToJson(const SimulationOptions& o) {
@@ -123,6 +142,7 @@ nlohmann::json bakeOptionsToJson(const SimulationOptions& o) {
   j["flux_threshold"] = o.flux_threshold;
   j["max_steps"] = o.max_steps;
   j["free_flight"] = o.free_flight;
+  j["volume_deposits"] = o.volume_deposits;
   j["boundary_on"] = o.boundary_on;
   j["boundary_off"] = o.boundary_off;
   if (o.receiver) {
@@ -178,10 +198,13 @@ SimulationOptions bakeOptionsFromJson(const nlohmann::json& j, const std::string
   number(j, "flux_threshold", o.flux_threshold, where("flux_threshold"));
   number(j, "boundary_on", o.boundary_on, where("boundary_on"));
   number(j, "boundary_off", o.boundary_off, where("boundary_off"));
-  if (j.contains("free_flight")) {
-    if (!j.at("free_flight").is_boolean()) throw InputError(source, where("free_flight"), "expected true or false");
-    o.free_flight = j.at("free_flight").get<bool>();
-  }
+  auto boolean = [&](const std::string& key, bool& out) {
+    if (!j.contains(key)) return;
+    if (!j.at(key).is_boolean()) throw InputError(source, where(key), "expected true or false");
+    out = j.at(key).get<bool>();
+  };
+  boolean("free_flight", o.free_flight);
+  boolean("volume_deposits", o.volume_deposits);
   if (j.contains("receiver")) {
     const nlohmann::json& r = j.at("receiver");
     if (!r.is_object()) throw InputError(source, where("receiver"), "expected an object");

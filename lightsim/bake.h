@@ -17,6 +17,12 @@ namespace eik {
 // volume's grid (3 components, one per voxel).
 void applyBake(Volume& volume, const BakeResult& result, const LightSpec& light);
 
+// Whether the viewer reads a bake's volume fields (irradiance, light_dir) for this volume: it does
+// for in-scattering (a `scatter` field with a non-zero albedo somewhere), for opaque embeddings (an
+// `opaque` field with its indicator set somewhere), and for the ground under the volume when no
+// receiver map is baked (`receiver_map` false). `lightsim --volume-deposits auto` deposits only then.
+bool viewerReadsVolumeLight(const Volume& volume, bool receiver_map);
+
 // The options a bake ran with, as the baked manifest's "bake_options" (`lightsim` writes it;
 // docs/volume-format.md): what a re-bake with another light needs to make the same kind of bake
 // (the viewer window's, viewer/background_bake.h). Not the progress callback or cancel flag.

@@ -640,11 +640,13 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
 
   const int max_steps = maxSteps(grid, options);
   const bool accumulate = options.deposit == DepositMode::Accumulate;
-  const bool track = accumulate && options.deposit_kernel == DepositKernel::Track;
+  const bool volume_deposits = options.volume_deposits;
+  const bool track = volume_deposits && accumulate && options.deposit_kernel == DepositKernel::Track;
 
-  // Deposit targets, in double (accumulate) or the strongest patch so far (max).
-  std::vector<DepositSum> sums(patches.empty() ? 0 : voxels);
-  std::vector<double> best_key(accumulate || patches.empty() ? 0 : voxels, -1.0);
+  // Deposit targets, in double (accumulate) or the strongest patch so far (max); none without
+  // volume deposits.
+  std::vector<DepositSum> sums(patches.empty() || !volume_deposits ? 0 : voxels);
+  std::vector<double> best_key(accumulate || sums.empty() ? 0 : voxels, -1.0);
 
   std::vector<PatchSamples> samples(patches.size());
   parallelFor(
@@ -692,7 +694,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
       stats.flux_reflected += r.reflected;
       if (r.rolled_back) ++stats.rollbacks;
       if (r.flight) ++stats.flights;
-      if (r.voxel >= 0) {
+      if (r.voxel >= 0 && volume_deposits) {
         const std::size_t v = static_cast<std::size_t>(r.voxel);
         if (accumulate) {
           sums[v].irradiance += r.deposit;
@@ -828,9 +830,11 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   // Output fields.
   phase.restart();
   bake.irradiance.components = 3;
-  bake.irradiance.data.assign(voxels * 3, 0.0f);
   bake.light_dir.components = 3;
-  bake.light_dir.data.assign(voxels * 3, 0.0f);
+  if (volume_deposits) {
+    bake.irradiance.data.assign(voxels * 3, 0.0f);
+    bake.light_dir.data.assign(voxels * 3, 0.0f);
+  }
   if (!sums.empty()) {
     parallelFor(
         0, static_cast<std::int64_t>(voxels),

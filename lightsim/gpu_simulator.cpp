@@ -262,8 +262,10 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   stats.initial_patches = initial.size();
   for (const Patch& p : initial) stats.flux_in += p.flux;
   if (initial.empty()) {  // the light misses the volume: an empty bake
-    bake.irradiance.data.assign(voxels * 3, 0.0f);
-    bake.light_dir.data.assign(voxels * 3, 0.0f);
+    if (options.volume_deposits) {
+      bake.irradiance.data.assign(voxels * 3, 0.0f);
+      bake.light_dir.data.assign(voxels * 3, 0.0f);
+    }
     if (options.receiver) {
       receiver.irradiance.assign(receiver.texelCount() * 3, 0.0f);
       bake.receivers.push_back(std::move(receiver));
@@ -363,10 +365,13 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     timer.start("analysis");
     analysisPass.run(L.b, L.a, count, L.targets, volume, gridUniforms, step);
     timer.start("deposit");
-    if (track)
+    if (!options.volume_deposits) {
+      // only the receiver's map (below)
+    } else if (track) {
       trackPassFor().run(L.a, L.b, L.targets.depositA, count, atlas, trackUniforms);
-    else
+    } else {
       depositPass.run(L.targets.depositA, L.targets.depositB, count, atlas, energyRef);
+    }
     if (options.receiver) {
       timer.start("receiver");
       receiverPassFor().run(L.b, L.targets.depositB, count, receiverTarget, receiver, origin);
@@ -444,7 +449,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   stats.rollbacks = static_cast<std::uint64_t>(std::llround(ledger.sum(gpu::kRolledBack).w));
 
   phaseWatch.restart();
-  atlas.toFields(bake.irradiance, bake.light_dir);
+  if (options.volume_deposits) atlas.toFields(bake.irradiance, bake.light_dir);
   if (options.receiver) {
     receiverTarget.fill(receiver);
     bake.receivers.push_back(std::move(receiver));

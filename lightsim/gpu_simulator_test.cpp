@@ -224,6 +224,44 @@ TEST(GpuSimulatorTest, SharpSphereOverAFloorWithTrackDepositsAndReceiverMatchesC
   }
 }
 
+// Without volume deposits (SimulationOptions::volume_deposits off: a clear object whose light only
+// the ground's map shows) both back ends leave the fields empty and bake the receiver map and the
+// ledger to the bit as with them: the deposits only read the step's results. The free flight of
+// `lightsim`'s default is on for the twin, whose quiet map is read only by the step.
+TEST(GpuSimulatorTest, WithoutVolumeDepositsTheReceiverMapAndLedgerAreTheSameToTheBit) {
+  const Volume volume = test_scenes::sharpVolume("procedural:sphere,r=0.5,ior=1.5", 32,
+                                                 Bounds{{-1.0, -0.8, -1.0}, {1.0, 0.6, 1.0}});
+  LightSpec light;
+  light.direction = glm::normalize(glm::dvec3(0.2, -1.0, 0.1));
+  SimulationOptions options;
+  options.max_depth = 4;
+  ReceiverSpec floor;
+  floor.point = {0.0, -0.75, 0.0};
+  floor.half_extent = 1.0;
+  options.receiver = floor;
+  SimulationOptions without = options;
+  without.volume_deposits = false;
+  test_scenes::glContext();
+  GpuSimulator gpu(volume);
+  CpuSimulator cpu(volume);
+  SimulationOptions flying = options, flying_without = without;
+  flying.free_flight = flying_without.free_flight = true;
+  const std::pair<BakeResult, BakeResult> runs[] = {{gpu.run(light, options), gpu.run(light, without)},
+                                                    {cpu.run(light, flying), cpu.run(light, flying_without)}};
+  for (const auto& [with_fields, map_only] : runs) {
+    SCOPED_TRACE(with_fields.stats.backend);
+    EXPECT_FALSE(with_fields.irradiance.data.empty());
+    EXPECT_TRUE(map_only.irradiance.data.empty());
+    EXPECT_TRUE(map_only.light_dir.data.empty());
+    ASSERT_EQ(map_only.receivers.size(), 1u);
+    EXPECT_EQ(map_only.receivers[0].irradiance, with_fields.receivers[0].irradiance);
+    EXPECT_GT(luminance(map_only.stats.flux_received), 0.5 * luminance(map_only.stats.flux_in));
+    EXPECT_EQ(map_only.stats.flux_received, with_fields.stats.flux_received);
+    EXPECT_EQ(map_only.stats.flux_out, with_fields.stats.flux_out);
+    EXPECT_EQ(map_only.stats.total_patches, with_fields.stats.total_patches);
+  }
+}
+
 // Voxels (with lum(irradiance) ≥ `floor`) whose GPU irradiance differs from the CPU's by more than
 // `tolerance` relative.
 int voxelsOff(const BakeResult& gpu, const BakeResult& cpu, double tolerance, double floor, int* considered) {

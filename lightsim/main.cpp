@@ -74,6 +74,12 @@ int run(int argc, char** argv) {
                  "on (default: the CPU twin crosses quiet space, where n is constant and no interface lies, in one "
                  "straight step; the same bake in fewer steps) or off (steps of --step everywhere, as the GPU path)")
       ->check(CLI::IsMember({"on", "off"}));
+  std::string volume_deposits = "auto";
+  app.add_option("--volume-deposits", volume_deposits,
+                 "auto (default: on where the viewer reads the volume's baked light: a scattering or opaque "
+                 "part, or no receiver map; otherwise only the receiver map is baked, several times faster for "
+                 "clear glass), on (always write irradiance and light_dir) or off (never)")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   app.add_option("--backend", backend,
                  "auto (default: gl on a hardware GPU for what the GPU path does, cpu otherwise), gl (the GPU "
                  "particle system) or cpu (the CPU twin, multi-threaded)")
@@ -156,6 +162,14 @@ int run(int argc, char** argv) {
   volume.require("ior", 1, input);
   volume.require("ior_grad", 3, input);
   if (max_depth->count() == 0) options.max_depth = volume.has("interfaces") ? 4 : 6;
+  options.volume_deposits = volume_deposits == "on" ||
+                            (volume_deposits == "auto" && viewerReadsVolumeLight(volume, options.receiver.has_value()));
+  if (!options.volume_deposits && !options.receiver)
+    throw InputError("command line", "--volume-deposits", "off needs a receiver (--receiver or a --scene with a ground): "
+                                                          "the bake would make nothing");
+  if (volume_deposits == "auto" && !options.volume_deposits && !quiet)
+    std::fprintf(stderr, "lightsim: --volume-deposits auto: nothing in the volume scatters or is opaque and the "
+                         "receiver gets a map, so only the map is baked (no irradiance/light_dir fields)\n");
 
   SimulatorBackendOptions choice;
   choice.backend = backend == "cpu"    ? SimulatorBackend::Cpu

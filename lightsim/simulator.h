@@ -81,6 +81,11 @@ struct SimulationOptions {
   // ignored otherwise. The CPU twin only: the GPU path steps by Δt everywhere. `lightsim` turns it
   // on (--free-flight); off here so that the twin and the GPU path compare step for step.
   bool free_flight = false;
+  // Volume deposits (ALGORITHM.md step 4): the bake's `irradiance` and `light_dir` fields. Off, a
+  // bake makes only the receiver's map (and the statistics): the deposits, most of a glass
+  // object's bake, are left out where nothing reads them (`lightsim --volume-deposits auto`,
+  // viewerReadsVolumeLight in bake.h), and BakeResult's fields are empty.
+  bool volume_deposits = true;
   double boundary_on = 0.02;      // |∇n|·h entering a boundary layer (Fresnel tracking)
   double boundary_off = 0.01;     // |∇n|·h leaving it
   ProgressFn progress;            // fraction of the entering flux retired (dead or exited)
@@ -135,6 +140,7 @@ struct SimulationStats {
 
 // What a bake adds to a volume (docs/volume-format.md).
 struct BakeResult {
+  // Empty (no data) when SimulationOptions::volume_deposits is off.
   Field irradiance;   // 3 components, W/m²
   Field light_dir;    // 3 components, unit (0 where no light passed)
   std::vector<ReceiverMap> receivers;  // the receiver's map, when one was given

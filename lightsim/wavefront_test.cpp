@@ -593,6 +593,38 @@ TEST(Bake, AddsFieldsAndManifestEntries) {
   EXPECT_THROW(applyBake(v, r, light), std::invalid_argument);
 }
 
+// A bake without volume deposits (empty fields) leaves no field of an earlier bake behind.
+TEST(Bake, ABakeWithoutVolumeDepositsRemovesAnEarlierBakesFields) {
+  Volume v = uniformVolume(cubicGrid(4, 0.5), 1.0);
+  v.addField("irradiance", 3);
+  v.addField("light_dir", 3);
+  BakeResult r;
+  r.irradiance.components = r.light_dir.components = 3;
+  applyBake(v, r, parseLight("directional:0,-1,0", "1"));
+  EXPECT_FALSE(v.has("irradiance"));
+  EXPECT_FALSE(v.has("light_dir"));
+  EXPECT_TRUE(v.has("ior"));
+  EXPECT_TRUE(v.metadata.contains("bake_stats"));
+}
+
+// The viewer reads a volume's baked light for in-scattering, opaque parts and, without a receiver
+// map, the ground: the deciding voxel is one of 64, so a check that skipped voxels would fail.
+TEST(Bake, TheViewerReadsTheVolumesLightWhereSomethingScattersOrIsOpaqueOrNoMapIsBaked) {
+  Volume glass = uniformVolume(cubicGrid(4, 0.5), 1.5);
+  EXPECT_FALSE(viewerReadsVolumeLight(glass, true));
+  EXPECT_TRUE(viewerReadsVolumeLight(glass, false));
+  Volume smoke = glass;
+  smoke.addField("scatter", 2).data[2 * 37 + 1] = 0.8f;  // g alone scatters nothing
+  EXPECT_FALSE(viewerReadsVolumeLight(smoke, true));
+  smoke.fields.at("scatter").data[2 * 37] = 0.5f;
+  EXPECT_TRUE(viewerReadsVolumeLight(smoke, true));
+  Volume embedded = glass;
+  embedded.addField("opaque", 4).data[4 * 63 + 0] = 0.7f;  // an albedo without the indicator
+  EXPECT_FALSE(viewerReadsVolumeLight(embedded, true));
+  embedded.fields.at("opaque").data[4 * 63 + 3] = 1.0f;
+  EXPECT_TRUE(viewerReadsVolumeLight(embedded, true));
+}
+
 TEST(Bake, StatsWarnWhenTheLightBroughtNothing) {
   SimulationStats s;
   EXPECT_TRUE(lightMissedVolume(s));

@@ -165,6 +165,41 @@ TEST(LightsimCli, BenchRepeatsTheBakeAndReportsItsFigures) {
   }
 }
 
+// --volume-deposits auto (the default): a clear glass ball over a ground bakes only the ground's map
+// and says so; with a receiver and an absorbing, scattering ball, or without a receiver, the fields
+// are written. `on` forces them, and its map is the auto bake's.
+TEST(LightsimCli, VolumeDepositsOnlyWhereTheViewerReadsThem) {
+  TempDir dir;
+  makeSphere(dir, true);
+  ProgramResult r = runProgram(VOXELIZE_EXE,
+                               {"procedural:sphere,r=0.5,sigma_a=0.2,scatter=1,g=0.3", "-o", "smoke.vol.json", "--res",
+                                "16", "--quiet"},
+                               dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  auto bake = [&](const std::string& in, const std::string& out, std::vector<std::string> extra) {
+    std::vector<std::string> args = {in, "-o", out, "--light", "directional:0,-1,0"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    ProgramResult b = runProgram(LIGHTSIM_EXE, args, dir.path());
+    EXPECT_EQ(b.exit_code, 0) << b.output;
+    return b.output;
+  };
+  const std::vector<std::string> ground = {"--receiver", "0,-0.6,0:0,1,0:1"};
+  const std::string said = bake("sharp.vol.json", "auto.vol.json", ground);
+  EXPECT_NE(said.find("--volume-deposits auto"), std::string::npos) << said;
+  bake("sharp.vol.json", "on.vol.json", {"--receiver", "0,-0.6,0:0,1,0:1", "--volume-deposits", "on", "--quiet"});
+  bake("sharp.vol.json", "no_ground.vol.json", {"--quiet"});
+  bake("smoke.vol.json", "smoke_baked.vol.json", {"--receiver", "0,-0.6,0:0,1,0:1", "--quiet"});
+  const Volume glass = readVolume(dir / "auto.vol.json"), forced = readVolume(dir / "on.vol.json");
+  EXPECT_FALSE(glass.has("irradiance") || glass.has("light_dir"));
+  ASSERT_EQ(glass.receivers.size(), 1u);
+  ASSERT_EQ(forced.receivers.size(), 1u);
+  EXPECT_EQ(glass.receivers[0].irradiance, forced.receivers[0].irradiance);
+  EXPECT_EQ(glass.metadata["bake_options"]["volume_deposits"], false);  // the window re-bakes the same way
+  EXPECT_TRUE(forced.has("irradiance") && forced.has("light_dir"));
+  EXPECT_TRUE(readVolume(dir / "no_ground.vol.json").has("irradiance"));
+  EXPECT_TRUE(readVolume(dir / "smoke_baked.vol.json").has("irradiance"));
+}
+
 TEST(LightsimCli, BadInputExitsTwo) {
   TempDir dir;
   makeSphere(dir);
@@ -195,6 +230,8 @@ TEST(LightsimCli, BadInputExitsTwo) {
       {{"missing.vol.json", "-o", "x.vol.json", "--light", "directional:0,-1,0"}, "missing.vol.json"},
       {{"ball.vol.json", "-o", "x.nrrd", "--light", "directional:0,-1,0"}, ".vol.json"},
       {{"ball.vol.json", "-o", "x.vol.json", "--light", "directional:0,-1,0", "--backend", "cuda"}, "--backend"},
+      {{"ball.vol.json", "-o", "x.vol.json", "--light", "directional:0,-1,0", "--volume-deposits", "off"},
+       "--volume-deposits"},
       {{"deep.vol.json", "-o", "x.vol.json", "--light", "directional:0,-1,0"}, "deep.vol.json: JSON: nested deeper"},
       {{"huge.vol.json", "-o", "x.vol.json", "--light", "directional:0,-1,0"},
        "huge.vol.json: spacing_hint: number out of range"},

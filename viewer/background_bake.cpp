@@ -28,7 +28,7 @@ std::vector<RebakeSource> rebakeSources(const LoadedScene& scene) {
     const LoadedObject& object = scene.objects[i];
     const Volume& volume = object.volume;
     const nlohmann::json light = volume.metadata.value("light", nlohmann::json());
-    if (!light.is_object() || light.value("type", std::string()) != "directional" || !volume.has("irradiance"))
+    if (!light.is_object() || light.value("type", std::string()) != "directional" || !(volume.has("irradiance") || !volume.receivers.empty()))
       continue;  // not baked by lightsim, or by a point light (the window moves a directional sun)
     RebakeSource s;
     s.object = static_cast<int>(i);

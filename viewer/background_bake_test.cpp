@@ -232,6 +232,7 @@ TEST(BackgroundBake, BakeOptionsRoundTripAndMalformedOnesAreRefusedByName) {
   o.flux_threshold = 1e-3;
   o.max_steps = 321;
   o.free_flight = true;
+  o.volume_deposits = false;
   ReceiverSpec r;
   r.name = "floor";
   r.point = {0.5, -1, 0};
@@ -242,6 +243,7 @@ TEST(BackgroundBake, BakeOptionsRoundTripAndMalformedOnesAreRefusedByName) {
   const SimulationOptions back = bakeOptionsFromJson(bakeOptionsToJson(o), "m.vol.json");
   EXPECT_EQ(bakeOptionsToJson(back), bakeOptionsToJson(o));
   EXPECT_EQ(back.max_steps, 321);
+  EXPECT_FALSE(back.volume_deposits);
   ASSERT_TRUE(back.receiver.has_value());
   EXPECT_EQ(back.receiver->name, "floor");
   EXPECT_EQ(back.receiver->point, r.point);
