@@ -143,6 +143,7 @@ nlohmann::json bakeOptionsToJson(const SimulationOptions& o) {
   j["max_steps"] = o.max_steps;
   j["free_flight"] = o.free_flight;
   j["volume_deposits"] = o.volume_deposits;
+  j["straight_step_voxels"] = o.straight_step_voxels;
   j["boundary_on"] = o.boundary_on;
   j["boundary_off"] = o.boundary_off;
   if (o.receiver) {
@@ -195,6 +196,7 @@ SimulationOptions bakeOptionsFromJson(const nlohmann::json& j, const std::string
   number(j, "step_voxels", o.step_voxels, where("step_voxels"));
   number(j, "patch_voxels", o.patch_voxels, where("patch_voxels"));
   number(j, "split_voxels", o.split_voxels, where("split_voxels"));
+  number(j, "straight_step_voxels", o.straight_step_voxels, where("straight_step_voxels"));
   number(j, "flux_threshold", o.flux_threshold, where("flux_threshold"));
   number(j, "boundary_on", o.boundary_on, where("boundary_on"));
   number(j, "boundary_off", o.boundary_off, where("boundary_off"));

@@ -99,11 +99,21 @@ PatchSamples samplePatch(const Patch& patch, const VolumeSampler& sampler) {
   return s;
 }
 
+bool straightSteps(const VolumeSampler& sampler, const SimulationOptions& options) {
+  if (!sampler.sharp() || sampler.hasAbsorption() || options.volume_deposits ||
+      !(options.straight_step_voxels > options.step_voxels))
+    return false;
+  for (const InterfaceSlot& slot : sampler.interfaces().slots)
+    if (slot.graded) return false;
+  return true;
+}
+
 StepContext makeStepContext(const VolumeSampler& sampler, const SimulationOptions& options, double flux_ref) {
   StepContext ctx;
   ctx.sampler = &sampler;
   ctx.options = &options;
   ctx.dt = timeStep(sampler.grid(), options);
+  ctx.step_dt = straightSteps(sampler, options) ? options.straight_step_voxels * voxelEdge(sampler.grid()) : ctx.dt;
   ctx.flux_ref = flux_ref;
   ctx.voxel_volume = sampler.grid().voxelVolume();
   propagationBox(sampler.grid(), options, ctx.box_lo, ctx.box_hi);
@@ -157,7 +167,7 @@ struct SharpUpdate {
 SharpUpdate updateCornersSharp(Patch& patch, PatchSamples& samples, const StepContext& ctx) {
   SharpUpdate u;
   for (int c = 0; c < 4; ++c) {
-    const CornerCrossings cc = advanceCornerSharp(patch.x[c], patch.w[c], patch.medium[c], samples.corner[c], ctx.dt,
+    const CornerCrossings cc = advanceCornerSharp(patch.x[c], patch.w[c], patch.medium[c], samples.corner[c], ctx.step_dt,
                                                   ctx.options->integrator, *ctx.sampler);
     const bool met = cc.transmitted > 0 || cc.reflected > 0 || cc.blocked;
     u.met_interface |= met;
@@ -273,7 +283,8 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
   const double n_m_old = samples.n_mid;
   // Free flight: one straight step of this time across quiet space (0: a step of Δt).
   const double flight = ctx.quiet && track ? freeFlightTime(patch, samples, ctx, threshold) : 0.0;
-  const double ds = (flight > 0.0 ? flight : ctx.dt) / n_m_old;  // Δs_m = Δt/n(m) (Eq. 4.11)
+  // Δs_m = Δt/n(m) (Eq. 4.11); a sharp volume's ordinary step may be a straight step (ctx.step_dt).
+  const double ds = (flight > 0.0 ? flight : sharp ? ctx.step_dt : ctx.dt) / n_m_old;
 
   // 1. Update (§6.2.2, Eq. 6.1/6.2 or RK2/RK4), then |w| = n(x_new); with sharp interfaces, Snell
   //    and Fresnel where a corner crosses one.
@@ -347,7 +358,7 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
       if (patch.bounce < options.bounces && patch.reflect_pending > 0.0 && patch.reflect_pending < 1.0 &&
           std::max(reflected_flux.x, std::max(reflected_flux.y, reflected_flux.z)) >=
               fluxKillThreshold(ctx.flux_ref, options, static_cast<int>(patch.depth)) &&
-          reflectedPatch(patch, sampler, 4.0 * ctx.dt + 2.0 * h, result.reflection)) {
+          reflectedPatch(patch, sampler, 4.0 * ctx.step_dt + 2.0 * h, result.reflection)) {
         result.spawn_reflection = true;
         result.reflection.flux = reflected_flux;
         result.reflection.area0 = result.reflection.area();

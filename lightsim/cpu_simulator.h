@@ -85,6 +85,9 @@ struct StepContext {
   const VolumeSampler* sampler = nullptr;
   const SimulationOptions* options = nullptr;
   double dt = 0.0;           // Δt
+  // Straight steps (SimulationOptions::straight_step_voxels): the time of an ordinary step when they
+  // apply to the run (straightSteps), else Δt.
+  double step_dt = 0.0;
   double flux_ref = 0.0;     // Φ_ref
   // Track deposits: patch-steps under this irradiance take the dim light's sub-path lattice
   // (track_deposit.h trackSpacing; kDimTrackFraction of brightestIrradiance). 0: none does.
@@ -97,6 +100,11 @@ struct StepContext {
   const QuietMap* quiet = nullptr;
   double flight_cap = 0.0;
 };
+
+// Whether straight steps apply to a run (SimulationOptions::straight_step_voxels): a sharp volume
+// whose materials all have a constant n (none graded), no absorption, no volume deposits (a track
+// deposit's sub-path is the chord of the step, not the kinked ray), and the option above Δt.
+bool straightSteps(const VolumeSampler& sampler, const SimulationOptions& options);
 
 // The constants of a run: Δt, the voxel volume, the propagation box (no receiver).
 StepContext makeStepContext(const VolumeSampler& sampler, const SimulationOptions& options, double flux_ref);

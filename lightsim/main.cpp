@@ -74,6 +74,12 @@ int run(int argc, char** argv) {
                  "on (default: the CPU twin crosses quiet space, where n is constant and no interface lies, in one "
                  "straight step; the same bake in fewer steps) or off (steps of --step everywhere, as the GPU path)")
       ->check(CLI::IsMember({"on", "off"}));
+  options.straight_step_voxels = 2.0;
+  app.add_option("--straight-step", options.straight_step_voxels,
+                 "VOXELS: the CPU twin's step where every ray is straight between sharp interfaces and crosses "
+                 "them exactly (materials of constant n, no absorption, no volume deposits; default 2, 0: off, "
+                 "steps of --step)")
+      ->check(CLI::Range(0.0, 64.0));
   std::string volume_deposits = "auto";
   app.add_option("--volume-deposits", volume_deposits,
                  "auto (default: on where the viewer reads the volume's baked light: a scattering or opaque "

@@ -81,6 +81,12 @@ struct SimulationOptions {
   // ignored otherwise. The CPU twin only: the GPU path steps by Δt everywhere. `lightsim` turns it
   // on (--free-flight); off here so that the twin and the GPU path compare step for step.
   bool free_flight = false;
+  // Straight steps (ALGORITHM.md "Straight steps"): in a sharp volume whose materials all have a
+  // constant n, with no absorption and no volume deposits, every corner's ray is straight between
+  // interfaces and crosses them exactly, so an ordinary step may be this many voxels instead of
+  // step_voxels; only where patches split and tear depends on it. 0 (or ≤ step_voxels): off. The
+  // CPU twin only; `lightsim` sets 2 (--straight-step), off here so that the back ends compare.
+  double straight_step_voxels = 0.0;
   // Volume deposits (ALGORITHM.md step 4): the bake's `irradiance` and `light_dir` fields. Off, a
   // bake makes only the receiver's map (and the statistics): the deposits, most of a glass
   // object's bake, are left out where nothing reads them (`lightsim --volume-deposits auto`,

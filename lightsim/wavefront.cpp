@@ -516,6 +516,8 @@ void validateOptions(const SimulationOptions& o) {
   if (!std::isfinite(o.flux_threshold) || o.flux_threshold < 0.0)
     throw InputError(kOptionsSource, "flux_threshold", "must not be negative");
   if (o.max_steps < 0) throw InputError(kOptionsSource, "max_steps", "must not be negative");
+  if (!std::isfinite(o.straight_step_voxels) || o.straight_step_voxels < 0.0 || o.straight_step_voxels > 64.0)
+    throw InputError(kOptionsSource, "straight_step_voxels", "must be in [0, 64]");
   if (!std::isfinite(o.boundary_on) || !std::isfinite(o.boundary_off) || o.boundary_off < 0.0 ||
       o.boundary_off > o.boundary_on)
     throw InputError(kOptionsSource, "boundary_off", "must be in [0, boundary_on]");
