@@ -92,6 +92,8 @@ double polygonArea(const glm::dvec2* p, int count) {
 // integral H(x) is piecewise quadratic and a texel's overlap is H(x₁) − H(x₀): exact, and a few
 // operations a texel instead of a clip.
 void depositRow(const ReceiverMap& map, const glm::dvec2* p, int n, const glm::dvec3& density, glm::dvec3* row) {
+  // A convex polygon of at most 4 vertices clipped by two half-planes has at most 6.
+  if (n < 3 || n > 8) return;
   double xs[8];
   for (int k = 0; k < n; ++k) xs[k] = p[k].x;
   std::sort(xs, xs + n);
@@ -139,28 +141,32 @@ void depositRow(const ReceiverMap& map, const glm::dvec2* p, int n, const glm::d
   }
 }
 
-void depositTriangle(const ReceiverMap& map, const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c,
-                     const glm::dvec3& flux, std::vector<glm::dvec3>& texel_flux, int row_begin, int row_end) {
-  const double area = 0.5 * std::abs(cross2(b - a, c - a));
+// Adds flux × area(polygon ∩ texel)/area(polygon) to the texels of rows [row_begin, row_end) for a
+// convex polygon of up to 4 vertices (a triangle, or a convex footprint whole), row by row.
+void depositConvex(const ReceiverMap& map, const glm::dvec2* polygon, int count, double area, const glm::dvec3& flux,
+                   std::vector<glm::dvec3>& texel_flux, int row_begin, int row_end) {
   if (!(area > 0.0)) {
     // A degenerate footprint (all corners on a line or a point): its flux goes to the texel of its centre.
-    const glm::dvec2 t = ((a + b + c) / 3.0 - map.origin) / map.pitch;
+    glm::dvec2 centre(0.0);
+    for (int k = 0; k < count; ++k) centre += polygon[k] / static_cast<double>(count);
+    const glm::dvec2 t = (centre - map.origin) / map.pitch;
     const int i = static_cast<int>(std::floor(t.x)), j = static_cast<int>(std::floor(t.y));
     if (i >= 0 && j >= std::max(0, row_begin) && i < map.texels.x && j < std::min(map.texels.y, row_end))
       texel_flux[static_cast<std::size_t>(j) * static_cast<std::size_t>(map.texels.x) + static_cast<std::size_t>(i)] += flux;
     return;
   }
-  const glm::dvec2 lo = (glm::min(a, glm::min(b, c)) - map.origin) / map.pitch;
-  const glm::dvec2 hi = (glm::max(a, glm::max(b, c)) - map.origin) / map.pitch;
-  const int j0 = std::max(std::max(0, row_begin), static_cast<int>(std::floor(lo.y)));
-  const int j1 = std::min(std::min(map.texels.y, row_end) - 1, static_cast<int>(std::floor(hi.y)));
+  double ylo = polygon[0].y, yhi = polygon[0].y;
+  for (int k = 1; k < count; ++k) ylo = std::min(ylo, polygon[k].y), yhi = std::max(yhi, polygon[k].y);
+  const int j0 = std::max(std::max(0, row_begin), static_cast<int>(std::floor((ylo - map.origin.y) / map.pitch)));
+  const int j1 = std::min(std::min(map.texels.y, row_end) - 1, static_cast<int>(std::floor((yhi - map.origin.y) / map.pitch)));
   const glm::dvec3 density = flux / area;
   for (int j = j0; j <= j1; ++j) {
-    // The triangle within this row of texels (clipped to the row): a convex polygon whose overlap
+    // The polygon within this row of texels (clipped to the row): a convex polygon whose overlap
     // with each texel of the row is the integral of its vertical extent over the texel's columns.
     const double y0 = map.origin.y + j * map.pitch, y1 = y0 + map.pitch;
-    glm::dvec2 buffer_a[8] = {a, b, c}, buffer_b[8];
-    int n = clipAgainst(buffer_a, 3, buffer_b, 1, y0, -1.0);
+    glm::dvec2 buffer_a[8], buffer_b[8];
+    for (int k = 0; k < count; ++k) buffer_a[k] = polygon[k];
+    int n = clipAgainst(buffer_a, count, buffer_b, 1, y0, -1.0);
     n = clipAgainst(buffer_b, n, buffer_a, 1, y1, 1.0);
     if (n < 3) continue;
     depositRow(map, buffer_a, n, density, &texel_flux[static_cast<std::size_t>(j) * static_cast<std::size_t>(map.texels.x)]);
@@ -216,9 +222,20 @@ void depositFootprint(const ReceiverMap& map, const std::array<glm::dvec2, 4>& f
   const double a1 = 0.5 * std::abs(cross2(f[1] - f[0], f[2] - f[0]));
   const double a2 = 0.5 * std::abs(cross2(f[2] - f[0], f[3] - f[0]));
   const double total = a1 + a2;
+  // A convex footprint (its four turns of one sign) whole: its triangles' shares by area give both
+  // one density, flux/total, so the quadrilateral gets the same overlaps in half the clipping.
+  double turns[4];
+  for (int k = 0; k < 4; ++k) turns[k] = cross2(f[(k + 1) % 4] - f[k], f[(k + 2) % 4] - f[(k + 1) % 4]);
+  const bool convex = (turns[0] > 0.0 && turns[1] > 0.0 && turns[2] > 0.0 && turns[3] > 0.0) ||
+                      (turns[0] < 0.0 && turns[1] < 0.0 && turns[2] < 0.0 && turns[3] < 0.0);
+  if (convex) {
+    depositConvex(map, f.data(), 4, total, flux, texel_flux, row_begin, row_end);
+    return;
+  }
   const double share = total > 0.0 ? a1 / total : 0.5;
-  depositTriangle(map, f[0], f[1], f[2], flux * share, texel_flux, row_begin, row_end);
-  depositTriangle(map, f[0], f[2], f[3], flux * (1.0 - share), texel_flux, row_begin, row_end);
+  const glm::dvec2 t1[3] = {f[0], f[1], f[2]}, t2[3] = {f[0], f[2], f[3]};
+  depositConvex(map, t1, 3, a1, flux * share, texel_flux, row_begin, row_end);
+  depositConvex(map, t2, 3, a2, flux * (1.0 - share), texel_flux, row_begin, row_end);
 }
 
 }  // namespace eik

@@ -13,7 +13,7 @@
 //            the triangle has no flux or lies off the map, or a footprint corner is not finite or
 //            ≥ 1e15 texels away (a negligible share of its flux would land on the map). A
 //            degenerate triangle (no area) gives its whole share to the texel of its centroid, as
-//            depositTriangle does (so a patch focused onto the plane is not lost).
+//            depositConvex does (so a patch focused onto the plane is not lost).
 //   fragment the exact area of triangle ∩ texel (Sutherland–Hodgman against the texel's four
 //            edges, shoelace area), out = share·overlap/|triangle area|, summed by additive
 //            blending (gl::ScopedBlendAdd) into the map's RGBA32F target; flux off the map is

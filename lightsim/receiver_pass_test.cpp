@@ -186,7 +186,7 @@ TEST(ReceiverPassTest, HandMadeFootprintsMatchTheCpu) {
     ASSERT_NEAR(area, e * e / std::cos(35 * deg), 1e-12) << "the footprint is stretched by 1/cos θ";
   }
   // A patch collapsed to a point (all corners and directions equal): a footprint of no area, in
-  // float and in double, whose flux goes to the texel of its centroid (depositTriangle).
+  // float and in double, whose flux goes to the texel of its centroid (depositConvex).
   Patch collapsed;
   for (std::size_t c = 0; c < 4; ++c) {
     collapsed.x[c] = onPlane(map, {20.5, 3.25}) + glm::dvec3(0.1, 0.3, -0.05);
