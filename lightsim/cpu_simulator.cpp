@@ -635,10 +635,10 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   }
   // The receiver's map (its geometry first: the initial patches cover it).
   ReceiverMap receiver;
-  std::vector<glm::dvec3> receiver_flux;
+  std::optional<FootprintSums> receiver_flux;
   if (options.receiver) {
     receiver = receiverGeometry(*options.receiver, light, grid, ctx.box_lo, ctx.box_hi);
-    receiver_flux.assign(receiver.texelCount(), glm::dvec3(0.0));
+    receiver_flux.emplace(receiver);
     ctx.receiver = &receiver;
   }
   double flux_ref = 0.0;
@@ -765,12 +765,13 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
     // The receiver's footprints, by bands of texel rows in parallel (each band adds the patches in
     // order, so the sums do not depend on the thread count).
     if (!received.empty()) {
-      constexpr int kBandRows = 16;
-      const int bands = (receiver.texels.y + kBandRows - 1) / kBandRows;
+      constexpr int kBandRows = FootprintSums::kBandRows;
+      const int bands = receiver_flux->bands();
       band_lists.resize(static_cast<std::size_t>(bands));
       for (auto& list : band_lists) list.clear();
       for (const std::uint32_t i : received) {
-        // The rows the footprint's box covers, hence the bands that get a share.
+        // The rows the footprint's box covers, hence the bands that get a share (one more on each
+        // side for a coarse level, whose texel rows are found from its own, rounded, coordinates).
         double lo = std::numeric_limits<double>::infinity(), hi = -lo;
         for (const glm::dvec2& f : results[i].footprint) {
           lo = std::min(lo, f.y);
@@ -778,14 +779,14 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
         }
         const double r0 = (lo - receiver.origin.y) / receiver.pitch, r1 = (hi - receiver.origin.y) / receiver.pitch;
         if (!(r1 >= 0.0 && r0 < receiver.texels.y)) continue;  // wholly off the map (or not finite)
-        const int b0 = static_cast<int>(std::max(0.0, r0)) / kBandRows;
-        const int b1 = static_cast<int>(std::min(static_cast<double>(receiver.texels.y - 1), r1)) / kBandRows;
+        const int margin = receiver_flux->level(results[i].footprint) > 0 ? 1 : 0;
+        const int b0 = std::max(0, static_cast<int>(std::max(0.0, r0)) / kBandRows - margin);
+        const int b1 = std::min(bands - 1, static_cast<int>(std::min(static_cast<double>(receiver.texels.y - 1), r1)) / kBandRows + margin);
         for (int b = b0; b <= b1; ++b) band_lists[static_cast<std::size_t>(b)].push_back(i);
       }
       parallelFor(0, bands, [&](std::int64_t band) {
-        const int row0 = static_cast<int>(band) * kBandRows;
         for (const std::uint32_t i : band_lists[static_cast<std::size_t>(band)])
-          depositFootprint(receiver, results[i].footprint, results[i].received, receiver_flux, row0, row0 + kBandRows);
+          receiver_flux->deposit(results[i].footprint, results[i].received, static_cast<int>(band));
       });
       received.clear();
     }
@@ -863,9 +864,10 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   if (options.receiver) {
     // Planar irradiance: each texel's flux over its area.
     const double inv_area = 1.0 / (receiver.pitch * receiver.pitch);
+    const std::vector<glm::dvec3> texel_flux = receiver_flux->resolve();
     receiver.irradiance.resize(receiver.texelCount() * 3);
     for (std::size_t t = 0; t < receiver.texelCount(); ++t)
-      for (int c = 0; c < 3; ++c) receiver.irradiance[3 * t + static_cast<std::size_t>(c)] = static_cast<float>(receiver_flux[t][c] * inv_area);
+      for (int c = 0; c < 3; ++c) receiver.irradiance[3 * t + static_cast<std::size_t>(c)] = static_cast<float>(texel_flux[t][c] * inv_area);
     bake.receivers.push_back(std::move(receiver));
   }
   stats.phase_seconds["update"] = t_update;

@@ -54,8 +54,10 @@ bool patchFootprint(const Patch& patch, const ReceiverMap& map, std::array<glm::
   for (int c = 0; c < 4; ++c) {
     const glm::dvec3 d = patch.w[c];
     const double facing = glm::dot(d, map.normal);
-    if (facing == 0.0) return false;
     const double height = glm::dot(patch.x[c] - map.point, map.normal);
+    // Parallel to the plane, or above it heading away: the ray never meets it (back along the ray
+    // is where it came from, not where it lands).
+    if (facing == 0.0 || (facing > 0.0 && height > 0.0)) return false;
     footprint[static_cast<std::size_t>(c)] = map.planeCoordinates(patch.x[c] - (height / facing) * d);
   }
   return true;
@@ -174,6 +176,51 @@ void depositConvex(const ReceiverMap& map, const glm::dvec2* polygon, int count,
 }
 
 }  // namespace
+
+FootprintSums::FootprintSums(const ReceiverMap& map) : map_(map) {
+  map_.irradiance.clear();
+  flux_.emplace_back(map.texelCount(), glm::dvec3(0.0));
+  for (int k = 1; k <= kFootprintLevels; ++k) {
+    ReceiverMap level = map_;
+    level.pitch = map.pitch * static_cast<double>(1 << k);
+    level.texels = (map.texels + glm::ivec2((1 << k) - 1)) / (1 << k);
+    flux_.emplace_back(level.texelCount(), glm::dvec3(0.0));
+    coarse_.push_back(std::move(level));
+  }
+}
+
+int FootprintSums::level(const std::array<glm::dvec2, 4>& f) const {
+  const glm::dvec2 lo = glm::min(glm::min(f[0], f[1]), glm::min(f[2], f[3]));
+  const glm::dvec2 hi = glm::max(glm::max(f[0], f[1]), glm::max(f[2], f[3]));
+  double texels = (hi.x - lo.x) * (hi.y - lo.y) / (map_.pitch * map_.pitch);
+  int k = 0;
+  while (k < kFootprintLevels && !(texels <= kFineFootprintTexels)) {  // NaN: the coarsest
+    texels *= 0.25;
+    ++k;
+  }
+  return k;
+}
+
+void FootprintSums::deposit(const std::array<glm::dvec2, 4>& footprint, const glm::dvec3& flux, int band) {
+  const int k = level(footprint);
+  const int rows = kBandRows >> k;
+  depositFootprint(k == 0 ? map_ : coarse_[static_cast<std::size_t>(k - 1)], footprint, flux,
+                   flux_[static_cast<std::size_t>(k)], band * rows, (band + 1) * rows);
+}
+
+std::vector<glm::dvec3> FootprintSums::resolve() const {
+  std::vector<glm::dvec3> out = flux_[0];
+  for (int k = 1; k <= kFootprintLevels; ++k) {
+    const ReceiverMap& level = coarse_[static_cast<std::size_t>(k - 1)];
+    const std::vector<glm::dvec3>& sums = flux_[static_cast<std::size_t>(k)];
+    const double share = 1.0 / static_cast<double>(1 << (2 * k));
+    for (int j = 0; j < map_.texels.y; ++j)
+      for (int i = 0; i < map_.texels.x; ++i)
+        out[static_cast<std::size_t>(j) * static_cast<std::size_t>(map_.texels.x) + static_cast<std::size_t>(i)] +=
+            sums[static_cast<std::size_t>(j >> k) * static_cast<std::size_t>(level.texels.x) + static_cast<std::size_t>(i >> k)] * share;
+  }
+  return out;
+}
 
 double triangleSquareOverlap(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c, const glm::dvec2& lo,
                              const glm::dvec2& hi) {

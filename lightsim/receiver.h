@@ -37,7 +37,8 @@ ReceiverMap receiverGeometry(const ReceiverSpec& spec, const LightSpec& light, c
 constexpr int kMaxReceiverTexels = 1024;
 
 // Where the rays of a patch's corners (x_c along w_c) meet the plane, in the plane's (u, v)
-// coordinates. False when a corner's ray runs parallel to the plane.
+// coordinates. False when a corner's ray never meets the plane: it runs parallel to it, or it is
+// above the plane heading away (the patch is then not received; it goes on, and leaves the box).
 bool patchFootprint(const Patch& patch, const ReceiverMap& map, std::array<glm::dvec2, 4>& footprint);
 
 // Adds flux Φ spread uniformly over the quadrilateral `footprint` ((u, v) coordinates) to the
@@ -49,6 +50,38 @@ bool patchFootprint(const Patch& patch, const ReceiverMap& map, std::array<glm::
 void depositFootprint(const ReceiverMap& map, const std::array<glm::dvec2, 4>& footprint, const glm::dvec3& flux,
                       std::vector<glm::dvec3>& texel_flux, int row_begin = 0,
                       int row_end = std::numeric_limits<int>::max());
+
+// The per-texel flux sums of a map being baked (the CPU twin's), with coarser levels for wide
+// footprints. A footprint whose box covers more than kFineFootprintTexels texels (dim light spread
+// thin: rays leaving an object at grazing angles, which land in long slivers across the map) goes to
+// the first level k ≤ kFootprintLevels, of texels 2^k times larger, where it covers at most that
+// many, or the last; resolve() spreads each coarse texel's flux evenly over its 4^k texels. So its
+// uniform flux density is kept over its quadrilateral to 1/16 of its size or finer, and the work
+// of a footprint is bounded, not its area in texels (measured on the 128³ sphere over a floor: 46 k
+// footprints that each crossed half the map). Footprints up to 16×16 texels (4 voxels at the
+// default pitch) are deposited exactly, as depositFootprint says.
+class FootprintSums {
+ public:
+  static constexpr int kFootprintLevels = 4;
+  static constexpr double kFineFootprintTexels = 256.0;
+  // Rows are filled in bands of this many (a multiple of 2^kFootprintLevels, so that a band of the
+  // map is a whole band of every level).
+  static constexpr int kBandRows = 16;
+
+  explicit FootprintSums(const ReceiverMap& map);
+  // The level a footprint goes to.
+  int level(const std::array<glm::dvec2, 4>& footprint) const;
+  // depositFootprint into its level, for the map rows of band `band` only.
+  void deposit(const std::array<glm::dvec2, 4>& footprint, const glm::dvec3& flux, int band);
+  int bands() const { return (map_.texels.y + kBandRows - 1) / kBandRows; }
+  // Each map texel's flux (W): its own plus its share of every coarser level's texel over it.
+  std::vector<glm::dvec3> resolve() const;
+
+ private:
+  ReceiverMap map_;                              // geometry only
+  std::vector<ReceiverMap> coarse_;              // level k ≥ 1 at index k − 1: pitch·2^k
+  std::vector<std::vector<glm::dvec3>> flux_;    // level k's per-texel flux
+};
 
 // Area of the intersection of triangle (a, b, c) with the axis-aligned square [lo, hi] (exact,
 // Sutherland–Hodgman clipping).

@@ -143,6 +143,62 @@ TEST(Receiver, APatchsFootprintFollowsItsCornerRays) {
   EXPECT_NEAR(f[2].y, 0.1, 1e-12);
   for (auto& w : p.w) w = glm::dvec3(1, 0, 0);
   EXPECT_FALSE(patchFootprint(p, map, f));  // parallel to the plane
+  // One corner above the plane heading away from it: its ray never lands (back along it is where it
+  // came from), so the patch is not received.
+  for (auto& w : p.w) w = d;
+  p.w[2] = glm::normalize(glm::dvec3(1, 0.01, 0));
+  EXPECT_FALSE(patchFootprint(p, map, f));
+  // Below the plane heading further down, it crossed it: the crossing is back along its ray.
+  for (auto& x : p.x) x.y = -1.0;
+  for (auto& w : p.w) w = d;
+  ASSERT_TRUE(patchFootprint(p, map, f));
+  EXPECT_NEAR(f[0].x, -1.0, 1e-12);
+}
+
+// FootprintSums: a footprint of up to 16×16 texels is deposited exactly as depositFootprint does,
+// to the bit; a wide one goes to a coarse level whose flux, spread over its texels, keeps the
+// footprint's flux (on the map) and its density inside, and reaches at most one coarse texel (16
+// map texels at the coarsest level) beyond the footprint's box. Bands in any order: the same sums.
+TEST(Receiver, WideFootprintsGoToCoarseLevelsAndKeepTheirFluxAndDensity) {
+  const ReceiverMap map = unitMap(100, 0.01);  // [−0.5, 0.5]², 7 bands of 16 rows (the last short)
+  const std::array<glm::dvec2, 4> small{{{-0.031, -0.052}, {0.071, -0.04}, {0.063, 0.061}, {-0.04, 0.05}}};
+  const std::array<glm::dvec2, 4> wide{{{-0.43, -0.12}, {0.38, -0.25}, {0.41, -0.07}, {-0.45, 0.11}}};
+  FootprintSums sums(map);
+  EXPECT_EQ(sums.level(small), 0);
+  EXPECT_EQ(sums.bands(), 7);
+  const int k = sums.level(wide);
+  EXPECT_GE(k, 1);
+  EXPECT_LE(k, FootprintSums::kFootprintLevels);
+  const glm::dvec3 phi_small(1.0, 2.0, 3.0), phi_wide(0.5);
+  for (int band = sums.bands() - 1; band >= 0; --band) {  // any order
+    sums.deposit(small, phi_small, band);
+    sums.deposit(wide, phi_wide, band);
+  }
+  const std::vector<glm::dvec3> both = sums.resolve();
+  FootprintSums small_only(map);
+  for (int band = 0; band < small_only.bands(); ++band) small_only.deposit(small, phi_small, band);
+  std::vector<glm::dvec3> exact(map.texelCount(), glm::dvec3(0.0));
+  depositFootprint(map, small, phi_small, exact);
+  EXPECT_EQ(small_only.resolve(), exact);
+  // The wide footprint: its flux, its density in a texel deep inside it, nothing far outside.
+  glm::dvec3 total(0.0);
+  for (std::size_t t = 0; t < both.size(); ++t) total += both[t] - exact[t];
+  EXPECT_NEAR(total.x, phi_wide.x, 1e-12);
+  auto cross = [](glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; };
+  const double area = 0.5 * std::abs(cross(wide[2] - wide[0], wide[3] - wide[1]));
+  const std::size_t inside = 45 * 100 + 30;  // texel [−0.2, −0.19] × [−0.05, −0.04]: 1/10 of the way from any edge
+  EXPECT_NEAR(both[inside].x - exact[inside].x, phi_wide.x * 1e-4 / area, 1e-12);
+  const int reach = 1 << k;
+  for (int j = 0; j < 100; ++j)
+    for (int i = 0; i < 100; ++i) {
+      const double u = -0.5 + 0.01 * i, v = -0.5 + 0.01 * j;  // the texel's low corner
+      const bool far = u > 0.41 + 0.01 * reach || u + 0.01 < -0.45 - 0.01 * reach || v > 0.11 + 0.01 * reach ||
+                       v + 0.01 < -0.25 - 0.01 * reach;
+      if (far) {
+        EXPECT_EQ(both[static_cast<std::size_t>(j * 100 + i)].x - exact[static_cast<std::size_t>(j * 100 + i)].x, 0.0)
+            << i << "," << j;
+      }
+    }
 }
 
 TEST(Receiver, TheMapCoversTheShadowAndOneShadowSizeAround) {

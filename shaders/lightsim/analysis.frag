@@ -47,10 +47,13 @@ layout(location = 3) out vec4 oLedgerA;
 layout(location = 4) out vec4 oLedgerB;
 
 #ifdef RECEIVER
-// The patch's footprint on the plane exists: no corner's ray runs parallel to it (patchFootprint).
+// The patch's footprint on the plane exists: every corner's ray meets the plane, none runs parallel
+// to it or away from it above it (patchFootprint).
 bool footprintExists(Patch p) {
-  for (int c = 0; c < 4; ++c)
-    if (dot(p.w[c], uReceiverNormal) == 0.0) return false;
+  for (int c = 0; c < 4; ++c) {
+    float facing = dot(p.w[c], uReceiverNormal);
+    if (facing == 0.0 || (facing > 0.0 && dot(p.x[c] - uReceiverPoint, uReceiverNormal) > 0.0)) return false;
+  }
   return true;
 }
 #endif
