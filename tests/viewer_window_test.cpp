@@ -81,6 +81,8 @@ TEST(ViewerWindowCli, MisusedFlagsExitTwo) {
       {{"ball.vol.json", "--render", "x.png", "--window-frames", "2", "--save", "y.exr"}, "--window-frames"},
       {{"ball.vol.json", "--window-frames", "2", "--save", "y.jpg"}, "--save"},
       {{"ball.vol.json", "--bench", "0"}, "--bench"},
+      {{"ball.vol.json", "--window-orbit", "5"}, "--window-orbit"},
+      {{"ball.vol.json", "--window-frames", "2", "--save", "y.exr", "--window-orbit", "5"}, "--window-orbit"},
   };
   for (const Case& c : cases) {
     ProgramResult r = runProgram(VIEWER_EXE, c.args, dir.path());

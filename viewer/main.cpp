@@ -104,6 +104,13 @@ int run(int argc, char** argv) {
       ->delimiter(',')
       ->expected(2)
       ->group("Scripted window (tests, screenshots)");
+  double window_orbit = 0.0;
+  app.add_option("--window-orbit", window_orbit,
+                 "with --window-frames: every frame but the first and last drags the camera PIXELS sideways (as the "
+                 "mouse does: rendered at a quarter of the resolution per axis), then prints the drag frames' median "
+                 "frame time and fps (the orbit's frame rate)")
+      ->check(CLI::Range(-1000.0, 1000.0))
+      ->group("Scripted window (tests, screenshots)");
   bool no_rebake = false;
   app.add_flag("--no-rebake", no_rebake,
                "window: the light sliders move only the unbaked light (ground, sun), no background re-bake");
@@ -133,6 +140,8 @@ int run(int argc, char** argv) {
     throw InputError("command line", "--save", "--window-frames N and --save OUT go together");
   if (window_frames > 0 && !window_mode)
     throw InputError("command line", "--window-frames", "is for the window: leave out --render and --bench");
+  if (window_orbit != 0.0 && window_frames < 3)
+    throw InputError("command line", "--window-orbit", "goes with --window-frames N (N >= 3) and --save OUT");
   if (!window_light.empty() && window_frames == 0)
     throw InputError("command line", "--window-light", "goes with --window-frames N and --save OUT");
   if (!window_light.empty() && (!std::isfinite(window_light[0]) || !(std::fabs(window_light[1]) <= 89.0)))
@@ -210,6 +219,7 @@ int run(int argc, char** argv) {
     options.save_ui = save_ui;
     if (!window_light.empty()) options.scripted_light = glm::dvec2(window_light[0], window_light[1]);
     options.rebake = !no_rebake;
+    options.scripted_orbit_px = window_orbit;
     options.quiet = quiet;
     return runViewerWindow(scene, settings, camera, options);
   }

@@ -19,6 +19,7 @@
 #include "gl/framebuffer.h"
 #include "gl/shader_library.h"
 #include "viewer/background_bake.h"
+#include "viewer/bench.h"
 #include "viewer/display_pass.h"
 #include "viewer/orbit_camera.h"
 #include "viewer/scene_renderer.h"
@@ -122,6 +123,14 @@ bool sameControls(const RenderSettings& a, const RenderSettings& b) {
 
 }  // namespace
 
+float nextDragScale(float scale, double render_ms, float max_scale) {
+  if (!(render_ms > 0.0) || !std::isfinite(render_ms)) return std::clamp(scale, kMinDragScale, max_scale);
+  const float wanted = std::clamp(static_cast<float>(scale * std::sqrt(kDragRenderBudgetMs / render_ms)),
+                                  kMinDragScale, std::max(kMinDragScale, max_scale));
+  return std::abs(wanted - scale) < 0.1f * scale ? std::clamp(scale, kMinDragScale, std::max(kMinDragScale, max_scale))
+                                                 : wanted;
+}
+
 glm::dvec3 lightDirectionFromAngles(double azimuth_deg, double elevation_deg, glm::dvec3 up) {
   up = unitOr(up, glm::dvec3(0, 1, 0));
   glm::dvec3 a, b;
@@ -187,6 +196,10 @@ int runViewerWindow(const LoadedScene& scene, const RenderSettings& initial_sett
   std::string status;
   int frame = 0;
   Stopwatch frame_clock;  // since the last frame was shown
+  float drag_scale = 0.25f;  // the resolution scale while dragging (nextDragScale)
+  bool was_dragging = false;
+  std::vector<double> orbit_frame_ms, orbit_render_ms;  // a scripted orbit's drag frames
+  glm::ivec2 orbit_size(0);
 
   // S: the current view at the window's full size (whatever the resolution slider says), rendered
   // as `--render` renders it; a failure to write is shown, not fatal.
@@ -339,8 +352,18 @@ int runViewerWindow(const LoadedScene& scene, const RenderSettings& initial_sett
     // Render the HDR image when something changed (always, in scripted mode).
     // While a mouse button drags the view, a quarter of the resolution at most: llvmpipe takes about
     // a second for a full 512² frame. The full image comes back when the button is released.
-    const bool dragging = !io.WantCaptureMouse && (io.MouseDown[0] || io.MouseDown[1] || io.MouseDown[2]);
-    const float scale = scripted ? 1.0f : dragging ? std::min(resolution_scale, 0.25f) : resolution_scale;
+    // A scripted orbit drags the camera as the left button does, on every frame but the first and last.
+    const bool orbiting = scripted && options.scripted_orbit_px != 0.0 && frame >= 1 && frame + 1 < options.scripted_frames;
+    if (orbiting) {
+      orbit.orbitByPixels(options.scripted_orbit_px, 0.0, std::max(1, fb.y));
+      dirty = true;
+    }
+    const bool dragging =
+        orbiting || (!scripted && !io.WantCaptureMouse && (io.MouseDown[0] || io.MouseDown[1] || io.MouseDown[2]));
+    // While dragging: the scale the last drag frames settled on, a quarter of the resolution at most.
+    if (dragging && !was_dragging) drag_scale = std::min(drag_scale, std::min(resolution_scale, 0.25f));
+    was_dragging = dragging;
+    const float scale = dragging ? drag_scale : scripted ? 1.0f : resolution_scale;
     const glm::ivec2 render_size = glm::max(glm::ivec2(glm::round(glm::vec2(fb) * scale)), glm::ivec2(1));
     if (!hdr || hdr.size() != render_size) {
       hdr = gl::Framebuffer(render_size, {gl::TextureFormat::RGBA32F});
@@ -353,6 +376,7 @@ int runViewerWindow(const LoadedScene& scene, const RenderSettings& initial_sett
       glFinish();
       render_ms = render_clock.milliseconds();
       dirty = false;
+      if (dragging) drag_scale = nextDragScale(drag_scale, render_ms, std::min(resolution_scale, 0.25f));
     }
 
     // Display pass into the window, then the panel on top.
@@ -393,6 +417,20 @@ int runViewerWindow(const LoadedScene& scene, const RenderSettings& initial_sett
     if (last_scripted_frame && !options.save_ui.empty()) writeScreenPng(options.save_ui, fb);
     context.swapBuffers();
     frame_ms = frame_clock.restart() * 1e3;
+    if (orbiting) {
+      orbit_frame_ms.push_back(frame_ms);
+      orbit_render_ms.push_back(render_ms);
+      orbit_size = render_size;
+    }
+  }
+  if (!orbit_frame_ms.empty()) {
+    if (options.report) *options.report = {orbit_frame_ms, orbit_render_ms, orbit_size};
+    if (!options.quiet) {
+      const double frame_median = medianOf(orbit_frame_ms);
+      std::fprintf(stderr, "viewer: orbit: %zu frames at %dx%d while dragging: median frame %.1f ms (%.1f fps), render %.1f ms\n",
+                   orbit_frame_ms.size(), orbit_size.x, orbit_size.y, frame_median, 1e3 / frame_median,
+                   medianOf(orbit_render_ms));
+    }
   }
   return kExitOk;
 }

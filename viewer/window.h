@@ -49,6 +49,17 @@ struct WindowOptions {
   // Scripted mode: after the first frame, move the light to these angles (azimuth, elevation in
   // degrees, as the sliders) and go on until its re-bake has landed (tests).
   std::optional<glm::dvec2> scripted_light;
+  // Scripted mode: every frame but the first and the last drags the camera this many pixels
+  // sideways, as the left mouse button does (so those frames render as while dragging: at most a
+  // quarter of the resolution per axis); the last frame, released, renders at full resolution. The
+  // drag frames' times go to `report` and are printed (`viewer --window-orbit`).
+  double scripted_orbit_px = 0.0;
+  struct Report {
+    std::vector<double> orbit_frame_ms;   // each drag frame, from one shown frame to the next
+    std::vector<double> orbit_render_ms;  // its render alone
+    glm::ivec2 orbit_render_size{0};      // the resolution it rendered at
+  };
+  Report* report = nullptr;  // filled when given
   bool quiet = false;
 };
 
@@ -56,6 +67,15 @@ struct WindowOptions {
 // scripted frames are done). Returns the exit code (0).
 int runViewerWindow(const LoadedScene& scene, const RenderSettings& settings, const Camera& camera,
                     const WindowOptions& options);
+
+// The resolution scale (per axis) of the next frame while the camera is dragged: the last drag
+// frame's scale corrected towards a render of kDragRenderBudgetMs (pixels cost about the same each,
+// so the scale goes with the square root of the time ratio), within [kMinDragScale, max_scale];
+// changes under 10 % are ignored (the frame's buffer is kept). So the view stays fluid however
+// heavy the scene: every DCC viewport does this.
+constexpr double kDragRenderBudgetMs = 40.0;
+constexpr float kMinDragScale = 1.0f / 16.0f;
+float nextDragScale(float scale, double render_ms, float max_scale);
 
 // The light's direction of travel from an azimuth and elevation (degrees) of the direction it
 // comes FROM, about `up` (the azimuth's zero is the projection of a fixed perpendicular), and back.

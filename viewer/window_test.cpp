@@ -20,6 +20,7 @@
 #include "gl/shader_library.h"
 #include "viewer/baked_ball_scene.h"
 #include "viewer/environment.h"
+#include "viewer/orbit_camera.h"
 #include "viewer/scene_renderer.h"
 
 namespace eik {
@@ -194,6 +195,70 @@ TEST(ViewerWindow, WindowImageEqualsHeadlessImageUnderADisplay) {
         if (shot_png.at(x, y)[c] != sb.at(x, y)[c]) ++shot_mismatches;
       }
   EXPECT_EQ(shot_mismatches, 0);
+}
+
+// While the camera is dragged the resolution follows the render budget: down when a frame takes
+// longer, up when it is quicker, never past the bounds, and small changes are ignored.
+TEST(ViewerWindow, DragScaleFollowsTheRenderBudget) {
+  // Four times over budget: half the resolution per axis (a quarter of the pixels).
+  EXPECT_NEAR(nextDragScale(0.25f, 4.0 * kDragRenderBudgetMs, 0.25f), 0.125f, 1e-6f);
+  // A quarter of the budget: twice the resolution, but not past the bound.
+  EXPECT_NEAR(nextDragScale(0.1f, 0.25 * kDragRenderBudgetMs, 0.25f), 0.2f, 1e-6f);
+  EXPECT_EQ(nextDragScale(0.2f, 0.25 * kDragRenderBudgetMs, 0.25f), 0.25f);
+  EXPECT_EQ(nextDragScale(0.1f, 1e4, 0.25f), kMinDragScale);
+  EXPECT_EQ(nextDragScale(0.2f, 1.1 * kDragRenderBudgetMs, 0.25f), 0.2f);  // under 10 %: kept
+  EXPECT_EQ(nextDragScale(0.2f, 0.0, 0.25f), 0.2f);                      // nothing measured
+  EXPECT_EQ(nextDragScale(0.2f, 1.0, 0.125f), 0.125f);                   // the slider lowered
+}
+
+// A scripted orbit (`viewer --window-orbit`): the drag frames render at a quarter of the window's
+// resolution per axis at most and report their times; the last frame, released, is the headless
+// render at the orbited camera (the same drags applied to the same OrbitCamera).
+TEST(ViewerWindow, AnOrbitRendersFewerPixelsWhileDraggingThenTheFullView) {
+  SKIP_WITHOUT_DISPLAY();
+  test_support::TempDir dir("eikonal-window-test");
+  LoadedScene scene = sceneFromVolume(glassBall(), "ball");
+  applyEnvironmentFlag("checker:1,0.9,0.8", scene.scene.environment);
+  RenderSettings settings;
+  const Camera camera{{0.3, 0.5, 2.2}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 40.0};
+  const glm::ivec2 size(96, 64);
+  WindowOptions options;
+  options.size = size;
+  options.scripted_frames = 5;
+  options.scripted_orbit_px = 12.0;
+  options.save = {dir / "window.exr"};
+  options.quiet = true;
+  WindowOptions::Report report;
+  options.report = &report;
+  RUN_WINDOW_OR_SKIP(scene, settings, camera, options);
+  ASSERT_EQ(report.orbit_frame_ms.size(), 3u);  // frames 2 to 4 of 5
+  EXPECT_EQ(report.orbit_render_ms.size(), 3u);
+  EXPECT_GT(report.orbit_render_size.x, 0);
+  EXPECT_LE(report.orbit_render_size.x, size.x / 4);
+  EXPECT_LE(report.orbit_render_size.y, size.y / 4);
+  OrbitCamera orbit(camera);
+  for (int i = 0; i < 3; ++i) orbit.orbitByPixels(12.0, 0.0, size.y);
+  Image headless;
+  {
+    gl::GlContext context;
+    gl::ShaderLibrary shaders;
+    SceneRenderer renderer(shaders, scene, settings);
+    headless = renderer.render(orbit.camera(), size);
+    // The orbit moved the view: the camera as loaded sees another picture.
+    const Image unmoved = renderer.render(camera, size);
+    double moved = 0.0;
+    for (std::size_t i = 0; i < unmoved.pixels.size(); ++i) moved += std::abs(unmoved.pixels[i] - headless.pixels[i]);
+    EXPECT_GT(moved, 0.01 * static_cast<double>(unmoved.pixels.size()));
+  }
+  writeImage(dir / "headless.exr", headless);
+  const Image a = readImage(dir / "window.exr");
+  const Image b = readImage(dir / "headless.exr");
+  ASSERT_EQ(a.width, size.x);
+  ASSERT_EQ(a.height, size.y);
+  int mismatches = 0;  // one half-float step, as WindowImageEqualsHeadlessImageUnderADisplay
+  for (std::size_t i = 0; i < a.pixels.size(); ++i)
+    if (i % 4 != 3 && std::abs(a.pixels[i] - b.pixels[i]) > 1e-3f * std::max(1.0f, std::abs(b.pixels[i]))) ++mismatches;
+  EXPECT_EQ(mismatches, 0);
 }
 
 TEST(ViewerWindow, ResizedWindowRendersAtItsNewSize) {
