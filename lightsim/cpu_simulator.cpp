@@ -100,7 +100,7 @@ PatchSamples samplePatch(const Patch& patch, const VolumeSampler& sampler) {
 }
 
 bool straightSteps(const VolumeSampler& sampler, const SimulationOptions& options) {
-  if (!sampler.sharp() || sampler.hasAbsorption() || options.volume_deposits ||
+  if (!sampler.sharp() || options.volume_deposits ||
       !(options.straight_step_voxels > options.step_voxels))
     return false;
   for (const InterfaceSlot& slot : sampler.interfaces().slots)
@@ -114,6 +114,8 @@ StepContext makeStepContext(const VolumeSampler& sampler, const SimulationOption
   ctx.options = &options;
   ctx.dt = timeStep(sampler.grid(), options);
   ctx.step_dt = straightSteps(sampler, options) ? options.straight_step_voxels * voxelEdge(sampler.grid()) : ctx.dt;
+  // A path of time t has length t/n (|dx/dt| = 1/n): at most this far from where it starts.
+  ctx.straight_reach = ctx.step_dt / std::min(1.0, sampler.minIor());
   ctx.flux_ref = flux_ref;
   ctx.voxel_volume = sampler.grid().voxelVolume();
   propagationBox(sampler.grid(), options, ctx.box_lo, ctx.box_hi);
@@ -164,10 +166,10 @@ struct SharpUpdate {
   int met_mask = 0;        // corners that met an interface (refracted, reflected or were stopped)
   int reflections = 0;     // total internal reflections, all corners
 };
-SharpUpdate updateCornersSharp(Patch& patch, PatchSamples& samples, const StepContext& ctx) {
+SharpUpdate updateCornersSharp(Patch& patch, PatchSamples& samples, const StepContext& ctx, double dt) {
   SharpUpdate u;
   for (int c = 0; c < 4; ++c) {
-    const CornerCrossings cc = advanceCornerSharp(patch.x[c], patch.w[c], patch.medium[c], samples.corner[c], ctx.step_dt,
+    const CornerCrossings cc = advanceCornerSharp(patch.x[c], patch.w[c], patch.medium[c], samples.corner[c], dt,
                                                   ctx.options->integrator, *ctx.sampler);
     const bool met = cc.transmitted > 0 || cc.reflected > 0 || cc.blocked;
     u.met_interface |= met;
@@ -178,6 +180,18 @@ SharpUpdate updateCornersSharp(Patch& patch, PatchSamples& samples, const StepCo
     u.transmittance *= std::pow(cc.transmittance, 0.25);
   }
   return u;
+}
+
+// The time of a sharp volume's ordinary step for this patch: a straight step (ctx.step_dt) where
+// they apply and, with absorption, nothing absorbs within its reach of the corners (then step 2's
+// σa at the midpoint is 0 along the whole step, as it is); else Δt.
+double sharpStepTime(const Patch& patch, const StepContext& ctx) {
+  if (!(ctx.step_dt > ctx.dt)) return ctx.dt;
+  if (!ctx.sampler->hasAbsorption()) return ctx.step_dt;
+  if (!ctx.absorbers) return ctx.dt;
+  glm::dvec3 lo = patch.x[0], hi = patch.x[0];
+  for (int c = 1; c < 4; ++c) lo = glm::min(lo, patch.x[c]), hi = glm::max(hi, patch.x[c]);
+  return ctx.absorbers->quiet(lo - ctx.straight_reach, hi + ctx.straight_reach) ? ctx.step_dt : ctx.dt;
 }
 
 // A patch meets an interface with some corners and not yet with the others. It will tear — the
@@ -283,8 +297,9 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
   const double n_m_old = samples.n_mid;
   // Free flight: one straight step of this time across quiet space (0: a step of Δt).
   const double flight = ctx.quiet && track ? freeFlightTime(patch, samples, ctx, threshold) : 0.0;
-  // Δs_m = Δt/n(m) (Eq. 4.11); a sharp volume's ordinary step may be a straight step (ctx.step_dt).
-  const double ds = (flight > 0.0 ? flight : sharp ? ctx.step_dt : ctx.dt) / n_m_old;
+  // Δs_m = Δt/n(m) (Eq. 4.11); a sharp volume's ordinary step may be a straight step.
+  const double step_dt = flight > 0.0 ? flight : sharp ? sharpStepTime(patch, ctx) : ctx.dt;
+  const double ds = step_dt / n_m_old;
 
   // 1. Update (§6.2.2, Eq. 6.1/6.2 or RK2/RK4), then |w| = n(x_new); with sharp interfaces, Snell
   //    and Fresnel where a corner crosses one.
@@ -299,7 +314,7 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
     }
   } else if (sharp) {
     const PatchSamples samples_before = samples;
-    crossing = updateCornersSharp(patch, samples, ctx);
+    crossing = updateCornersSharp(patch, samples, ctx, step_dt);
     // A tear: undo the step and split the patch as it was, so that its parts cross on their own.
     // Either the step stretched it far, or it is the patch's first touch of an interface and some
     // corners will not follow (willTear).
@@ -632,6 +647,10 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
     if (quiet_.empty()) quiet_ = sampler_.quietMap();
     ctx.quiet = &quiet_;
     ctx.flight_cap = glm::length(ctx.box_hi - ctx.box_lo);
+  }
+  if (ctx.step_dt > ctx.dt && sampler_.hasAbsorption()) {
+    if (absorbers_.empty()) absorbers_ = sampler_.absorberMap();
+    ctx.absorbers = &absorbers_;
   }
   // The receiver's map (its geometry first: the initial patches cover it).
   ReceiverMap receiver;

@@ -46,6 +46,7 @@ class CpuSimulator : public Simulator {
  private:
   VolumeSampler sampler_;
   QuietMap quiet_;  // built by the first run with free flight
+  QuietMap absorbers_;  // built by the first run with straight steps in a volume with absorption
 };
 
 // One step of one patch in place: ALGORITHM.md steps 1–5 (update, absorption, Fresnel, deposit
@@ -88,6 +89,10 @@ struct StepContext {
   // Straight steps (SimulationOptions::straight_step_voxels): the time of an ordinary step when they
   // apply to the run (straightSteps), else Δt.
   double step_dt = 0.0;
+  // …and, in a volume with absorption, the voxels that absorb (a straight step is taken only where
+  // its reach, straight_reach world units around the corners, has σa = 0); none: Δt there.
+  const QuietMap* absorbers = nullptr;
+  double straight_reach = 0.0;
   double flux_ref = 0.0;     // Φ_ref
   // Track deposits: patch-steps under this irradiance take the dim light's sub-path lattice
   // (track_deposit.h trackSpacing; kDimTrackFraction of brightestIrradiance). 0: none does.
@@ -102,8 +107,9 @@ struct StepContext {
 };
 
 // Whether straight steps apply to a run (SimulationOptions::straight_step_voxels): a sharp volume
-// whose materials all have a constant n (none graded), no absorption, no volume deposits (a track
-// deposit's sub-path is the chord of the step, not the kinked ray), and the option above Δt.
+// whose materials all have a constant n (none graded), no volume deposits (a track deposit's
+// sub-path is the chord of the step, not the kinked ray), and the option above Δt. With absorption,
+// only steps whose reach has σa = 0 (StepContext::absorbers).
 bool straightSteps(const VolumeSampler& sampler, const SimulationOptions& options);
 
 // The constants of a run: Δt, the voxel volume, the propagation box (no receiver).

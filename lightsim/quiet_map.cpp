@@ -26,9 +26,7 @@ QuietMap::QuietMap(const GridSpec& grid, const std::vector<glm::vec4>& ior_grad,
     : grid_(grid) {
   const glm::ivec3 d = grid.dims;
   if (d.x <= 0 || d.y <= 0 || d.z <= 0 || ior_grad.size() != grid.count()) return;
-  const int longest = std::max(d.x, std::max(d.y, d.z));
-  brick_ = longest <= 160 ? 1 : longest <= 512 ? 2 : 4;
-  bricks_ = (d + (brick_ - 1)) / brick_;
+  chooseBricks();
   const bool sharp = !table.empty() && distances.size() == grid.count();
   const int slots = sharp ? static_cast<int>(table.slots.size()) : 0;
   auto signature = [&](std::size_t v) {
@@ -56,11 +54,7 @@ QuietMap::QuietMap(const GridSpec& grid, const std::vector<glm::vec4>& ior_grad,
     return s;
   };
   std::vector<std::uint8_t> flag(static_cast<std::size_t>(bricks_.x) * bricks_.y * bricks_.z, 0);
-  auto brick = [&](int x, int y, int z) -> std::uint8_t& {
-    return flag[static_cast<std::size_t>(x / brick_) +
-                static_cast<std::size_t>(bricks_.x) *
-                    (static_cast<std::size_t>(y / brick_) + static_cast<std::size_t>(bricks_.y) * static_cast<std::size_t>(z / brick_))];
-  };
+  auto brick = [&](int x, int y, int z) -> std::uint8_t& { return brickFlag(flag, x, y, z); };
   for (int z = 0; z < d.z; ++z)
     for (int y = 0; y < d.y; ++y)
       for (int x = 0; x < d.x; ++x) {
@@ -75,6 +69,35 @@ QuietMap::QuietMap(const GridSpec& grid, const std::vector<glm::vec4>& ior_grad,
           }
         }
       }
+  buildTable(flag);
+}
+
+QuietMap::QuietMap(const GridSpec& grid, const std::vector<std::uint8_t>& flagged_voxels) : grid_(grid) {
+  const glm::ivec3 d = grid.dims;
+  if (d.x <= 0 || d.y <= 0 || d.z <= 0 || flagged_voxels.size() != grid.count()) return;
+  chooseBricks();
+  std::vector<std::uint8_t> flag(static_cast<std::size_t>(bricks_.x) * bricks_.y * bricks_.z, 0);
+  for (int z = 0; z < d.z; ++z)
+    for (int y = 0; y < d.y; ++y)
+      for (int x = 0; x < d.x; ++x)
+        if (flagged_voxels[grid.index(x, y, z)]) brickFlag(flag, x, y, z) = 1;
+  buildTable(flag);
+}
+
+void QuietMap::chooseBricks() {
+  const glm::ivec3 d = grid_.dims;
+  const int longest = std::max(d.x, std::max(d.y, d.z));
+  brick_ = longest <= 160 ? 1 : longest <= 512 ? 2 : 4;
+  bricks_ = (d + (brick_ - 1)) / brick_;
+}
+
+std::vector<std::uint8_t>::reference QuietMap::brickFlag(std::vector<std::uint8_t>& flags, int x, int y, int z) const {
+  return flags[static_cast<std::size_t>(x / brick_) +
+               static_cast<std::size_t>(bricks_.x) *
+                   (static_cast<std::size_t>(y / brick_) + static_cast<std::size_t>(bricks_.y) * static_cast<std::size_t>(z / brick_))];
+}
+
+void QuietMap::buildTable(const std::vector<std::uint8_t>& flag) {
   const std::size_t sx = static_cast<std::size_t>(bricks_.x) + 1, sy = static_cast<std::size_t>(bricks_.y) + 1;
   sat_.assign(sx * sy * (static_cast<std::size_t>(bricks_.z) + 1), 0);
   for (int k = 1; k <= bricks_.z; ++k)

@@ -33,6 +33,11 @@ class QuietMap {
   QuietMap(const GridSpec& grid, const std::vector<glm::vec4>& ior_grad, const std::vector<glm::vec4>& distances,
            const InterfaceTable& table, const std::vector<glm::vec3>& sigma_a);
 
+  // From flags of the voxels themselves (no neighbours compared): a box is quiet when no trilinear
+  // sample in it touches a flagged voxel. VolumeSampler::absorberMap flags the absorbing voxels, so
+  // a quiet box is one where σa = 0 everywhere (straight steps in absorbing volumes).
+  QuietMap(const GridSpec& grid, const std::vector<std::uint8_t>& flagged_voxels);
+
   // Does every trilinear sample (GL_LINEAR, clamp-to-edge) at a point of the world box [lo, hi]
   // see the same material with constant optics? Points outside the grid sample its edge voxels,
   // so a box beyond the grid is quiet when the edge voxels it clamps to are. False for a box that
@@ -52,6 +57,10 @@ class QuietMap {
   // Summed-area table of the noisy flags, (bricks + 1)³ entries; entry (i, j, k) counts the noisy
   // bricks with indices below (i, j, k).
   std::vector<std::uint32_t> sat_;
+  // The brick size for the grid, and the summed-area table over per-brick flags.
+  void chooseBricks();
+  std::vector<std::uint8_t>::reference brickFlag(std::vector<std::uint8_t>& flags, int x, int y, int z) const;
+  void buildTable(const std::vector<std::uint8_t>& brick_flags);
   std::uint32_t sat(int i, int j, int k) const {
     return sat_[static_cast<std::size_t>(i) +
                 static_cast<std::size_t>(bricks_.x + 1) *

@@ -108,5 +108,29 @@ TEST(QuietMap, AbsorptionEdgesAreNotQuietAndUniformAbsorptionIs) {
   EXPECT_TRUE(all.quiet(glm::dvec3(-0.5), glm::dvec3(0.5)));
 }
 
+// From flagged voxels (VolumeSampler::absorberMap): a box is quiet exactly when no trilinear sample
+// in it takes a flagged voxel as one of its eight taps (taps floor(q − ½) and the next, at voxel
+// coordinate q; 8³ voxels of 1/8, so brick = voxel); an absorbing sphere's map is not quiet at it.
+TEST(QuietMap, FlaggedVoxelsMakeTheBoxesWhoseSamplesTouchThemNoisy) {
+  const GridSpec grid = cubicGrid(8, 0.5);  // [−0.5, 0.5]³, voxel edge 1/8
+  std::vector<std::uint8_t> flags(grid.count(), 0);
+  flags[grid.index(3, 4, 5)] = 1;
+  const QuietMap map(grid, flags);
+  ASSERT_FALSE(map.empty());
+  EXPECT_EQ(map.noisyBricks(), 1u);
+  auto world = [&](double qx, double qy, double qz) { return grid.bounds_min + glm::dvec3(qx, qy, qz) / 8.0; };
+  // At voxel x-coordinate 4.4 the x-taps are 3 and 4: it touches voxel 3; at 4.6 they are 4 and 5.
+  EXPECT_FALSE(map.quiet(world(4.4, 4.5, 5.5), world(4.4, 4.5, 5.5)));
+  EXPECT_TRUE(map.quiet(world(4.6, 4.5, 5.5), world(4.6, 4.5, 5.5)));
+  EXPECT_TRUE(map.quiet(world(4.6, 0.0, 0.0), world(8.0, 8.0, 8.0)));
+  EXPECT_FALSE(map.quiet(world(4.4, 0.0, 0.0), world(8.0, 8.0, 8.0)));
+  EXPECT_TRUE(map.quiet(world(0.0, 0.0, 0.0), world(2.4, 8.0, 8.0)));  // x-taps up to 2: clear of 3
+  EXPECT_FALSE(map.quiet(world(0.0, 0.0, 0.0), world(2.6, 8.0, 8.0)));
+  const VolumeSampler absorbing(absorbingSphere(16, cube(0.5), 0.3, 2.0));
+  const QuietMap absorbers = absorbing.absorberMap();
+  EXPECT_FALSE(absorbers.quiet(glm::dvec3(-0.05), glm::dvec3(0.05)));
+  EXPECT_TRUE(absorbers.quiet(glm::dvec3(0.42), glm::dvec3(0.5)));  // a corner of the grid, clear of it
+}
+
 }  // namespace
 }  // namespace eik

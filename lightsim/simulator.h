@@ -82,9 +82,9 @@ struct SimulationOptions {
   // on (--free-flight); off here so that the twin and the GPU path compare step for step.
   bool free_flight = false;
   // Straight steps (ALGORITHM.md "Straight steps"): in a sharp volume whose materials all have a
-  // constant n, with no absorption and no volume deposits, every corner's ray is straight between
-  // interfaces and crosses them exactly, so an ordinary step may be this many voxels instead of
-  // step_voxels; only where patches split and tear depends on it. 0 (or ≤ step_voxels): off. The
+  // constant n, with no volume deposits, every corner's ray is straight between interfaces and
+  // crosses them exactly, so an ordinary step may be this many voxels instead of step_voxels where
+  // nothing absorbs within its reach; only where patches split and tear depends on it. 0 (or ≤ step_voxels): off. The
   // CPU twin only; `lightsim` sets 2 (--straight-step), off here so that the back ends compare.
   double straight_step_voxels = 0.0;
   // Volume deposits (ALGORITHM.md step 4): the bake's `irradiance` and `light_dir` fields. Off, a

@@ -163,6 +163,24 @@ glm::dvec4 VolumeSampler::materialOptics(int slot, const glm::dvec3& world) cons
 
 QuietMap VolumeSampler::quietMap() const { return QuietMap(grid_, ior_grad_, distances_, table_, sigma_a_); }
 
+QuietMap VolumeSampler::absorberMap() const {
+  std::vector<std::uint8_t> flags(grid_.count(), 0);
+  for (std::size_t i = 0; i < sigma_a_.size() && i < flags.size(); ++i)
+    flags[i] = sigma_a_[i].x != 0.0f || sigma_a_[i].y != 0.0f || sigma_a_[i].z != 0.0f;
+  return QuietMap(grid_, flags);
+}
+
+double VolumeSampler::minIor() const {
+  double n = std::numeric_limits<double>::infinity();
+  if (sharp()) {
+    n = 1.0;  // air
+    for (const InterfaceSlot& slot : table_.slots)
+      if (!slot.graded) n = std::min(n, slot.ior);
+  }
+  for (const glm::vec4& g : ior_grad_) n = std::min(n, static_cast<double>(g.x));  // graded slots and smoothed n
+  return n;
+}
+
 glm::dvec3 VolumeSampler::interfaceNormal(int slot, const glm::dvec3& world) const {
   const glm::dvec3 h = 0.5 * grid_.voxelSize();
   glm::dvec3 g;

@@ -126,6 +126,10 @@ class VolumeSampler {
   glm::dvec3 interfaceNormal(int slot, const glm::dvec3& world) const;
   // The bricks where a straight step is exact (quiet_map.h), built from the fields held here.
   QuietMap quietMap() const;
+  // The voxels with σa ≠ 0 (any channel) as a QuietMap: its quiet boxes have no absorption.
+  QuietMap absorberMap() const;
+  // The smallest n of any material (sharp interfaces: every slot and air; else the ior field).
+  double minIor() const;
 
  private:
   GridSpec grid_;

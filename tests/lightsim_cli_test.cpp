@@ -183,10 +183,12 @@ TEST(LightsimCli, VolumeDepositsOnlyWhereTheViewerReadsThem) {
     EXPECT_EQ(b.exit_code, 0) << b.output;
     return b.output;
   };
-  const std::vector<std::string> ground = {"--receiver", "0,-0.6,0:0,1,0:1"};
+  // Steps of Δt for both (straight steps, lightsim's default, need the volume deposits off).
+  const std::vector<std::string> ground = {"--receiver", "0,-0.6,0:0,1,0:1", "--straight-step", "0"};
   const std::string said = bake("sharp.vol.json", "auto.vol.json", ground);
   EXPECT_NE(said.find("--volume-deposits auto"), std::string::npos) << said;
-  bake("sharp.vol.json", "on.vol.json", {"--receiver", "0,-0.6,0:0,1,0:1", "--volume-deposits", "on", "--quiet"});
+  bake("sharp.vol.json", "on.vol.json",
+       {"--receiver", "0,-0.6,0:0,1,0:1", "--straight-step", "0", "--volume-deposits", "on", "--quiet"});
   bake("sharp.vol.json", "no_ground.vol.json", {"--quiet"});
   bake("smoke.vol.json", "smoke_baked.vol.json", {"--receiver", "0,-0.6,0:0,1,0:1", "--quiet"});
   const Volume glass = readVolume(dir / "auto.vol.json"), forced = readVolume(dir / "on.vol.json");
