@@ -132,25 +132,7 @@ glm::dvec4 VolumeSampler::iorAndGradient(const glm::dvec3& world) const {
 
 glm::dvec4 VolumeSampler::distances(const glm::dvec3& world) const {
   if (distances_.empty()) return glm::dvec4(0.0);
-  // In float, as the GPU samples them (four slots at once: the compiler's vector lanes); the
-  // weights from the double voxel coordinate.
-  const Taps3 t = taps3(grid_, world, grid_.extent());
-  const std::size_t nx = static_cast<std::size_t>(grid_.dims.x);
-  const std::size_t nxy = nx * static_cast<std::size_t>(grid_.dims.y);
-  const std::size_t y0 = static_cast<std::size_t>(t.y.i0) * nx, y1 = static_cast<std::size_t>(t.y.i1) * nx;
-  const std::size_t z0 = static_cast<std::size_t>(t.z.i0) * nxy, z1 = static_cast<std::size_t>(t.z.i1) * nxy;
-  const std::size_t x0 = static_cast<std::size_t>(t.x.i0), x1 = static_cast<std::size_t>(t.x.i1);
-  const float fx = static_cast<float>(t.x.f), fy = static_cast<float>(t.y.f), fz = static_cast<float>(t.z.f);
-  const float w[8] = {(1 - fx) * (1 - fy) * (1 - fz), fx * (1 - fy) * (1 - fz), (1 - fx) * fy * (1 - fz), fx * fy * (1 - fz),
-                      (1 - fx) * (1 - fy) * fz,       fx * (1 - fy) * fz,       (1 - fx) * fy * fz,       fx * fy * fz};
-  const std::size_t at[8] = {x0 + y0 + z0, x1 + y0 + z0, x0 + y1 + z0, x1 + y1 + z0,
-                             x0 + y0 + z1, x1 + y0 + z1, x0 + y1 + z1, x1 + y1 + z1};
-  float sum[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-  for (int k = 0; k < 8; ++k) {
-    const float* v = &distances_[at[k]].x;
-    for (int c = 0; c < 4; ++c) sum[c] += w[k] * v[c];
-  }
-  return {sum[0], sum[1], sum[2], sum[3]};
+  return interpolate<glm::dvec4>(distances_, grid_, taps3(grid_, world, grid_.extent()));
 }
 
 glm::dvec4 VolumeSampler::materialOptics(int slot, const glm::dvec3& world) const {
