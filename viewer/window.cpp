@@ -124,11 +124,11 @@ bool sameControls(const RenderSettings& a, const RenderSettings& b) {
 }  // namespace
 
 float nextDragScale(float scale, double render_ms, float max_scale) {
-  if (!(render_ms > 0.0) || !std::isfinite(render_ms)) return std::clamp(scale, kMinDragScale, max_scale);
-  const float wanted = std::clamp(static_cast<float>(scale * std::sqrt(kDragRenderBudgetMs / render_ms)),
-                                  kMinDragScale, std::max(kMinDragScale, max_scale));
-  return std::abs(wanted - scale) < 0.1f * scale ? std::clamp(scale, kMinDragScale, std::max(kMinDragScale, max_scale))
-                                                 : wanted;
+  const float top = std::max(kMinDragScale, max_scale);  // (a slider below the minimum: the minimum)
+  const float kept = std::clamp(scale, kMinDragScale, top);
+  if (!(render_ms > 0.0) || !std::isfinite(render_ms)) return kept;
+  const float wanted = std::clamp(static_cast<float>(scale * std::sqrt(kDragRenderBudgetMs / render_ms)), kMinDragScale, top);
+  return std::abs(wanted - scale) < 0.1f * scale ? kept : wanted;
 }
 
 glm::dvec3 lightDirectionFromAngles(double azimuth_deg, double elevation_deg, glm::dvec3 up) {

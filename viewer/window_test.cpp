@@ -226,6 +226,7 @@ TEST(ViewerWindow, DragScaleFollowsTheRenderBudget) {
   EXPECT_EQ(nextDragScale(0.2f, 1.1 * kDragRenderBudgetMs, 0.25f), 0.2f);  // under 10 %: kept
   EXPECT_EQ(nextDragScale(0.2f, 0.0, 0.25f), 0.2f);                      // nothing measured
   EXPECT_EQ(nextDragScale(0.2f, 1.0, 0.125f), 0.125f);                   // the slider lowered
+  EXPECT_EQ(nextDragScale(0.2f, 0.0, 0.01f), kMinDragScale);              // a bound under the minimum
 }
 
 // A scripted orbit (`viewer --window-orbit`): the drag frames render at a quarter of the window's
