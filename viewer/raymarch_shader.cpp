@@ -75,7 +75,7 @@ std::vector<std::string> definedNames(const std::string& defines) {
   for (std::string line; std::getline(lines, line);) {
     std::istringstream words(line);
     std::string directive, name;
-    if (words >> directive >> name && directive == "#define") names.push_back(name);
+    if (words >> directive >> name && directive == "#define") names.push_back(name.substr(0, name.find('(')));
   }
   return names;
 }
@@ -175,6 +175,31 @@ std::string interfaceDefines(const InterfaceTable& table) {
   // No graded slot: n is a constant wherever the ray is, and the march never reads the ior field.
   if (std::none_of(table.slots.begin(), table.slots.end(), [](const InterfaceSlot& s) { return s.graded; }))
     out += "#define CONSTANT_SLOTS 1\n";
+  return out;
+}
+
+std::string slotMediumDefines(const SlotMedia& media) {
+  auto number = [](double x) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.9g", x);
+    return std::string(text);
+  };
+  // A chain of selects on the material k, air last: constants only, so no fetch and no branch.
+  auto perMaterial = [&](const char* name, const char* type, auto&& literal) {
+    std::string out = std::string("#define ") + name + "(k) (";
+    for (std::size_t m = 1; m < media.media.size(); ++m)
+      out += "(k) == " + std::to_string(m - 1) + " ? " + type + "(" + literal(media.media[m]) + ") : ";
+    return out + type + "(" + literal(media.media[0]) + "))\n";
+  };
+  std::string out;
+  if (media.sigma_a_constant)
+    out += perMaterial("MEDIUM_SIGMA_A", "vec3", [&](const MaterialMedium& m) {
+      return number(m.sigma_a.x) + ", " + number(m.sigma_a.y) + ", " + number(m.sigma_a.z);
+    });
+  if (media.scatter_constant)
+    out += perMaterial("MEDIUM_SCATTER", "vec2", [&](const MaterialMedium& m) {
+      return number(m.scatter.x) + ", " + number(m.scatter.y);
+    });
   return out;
 }
 

@@ -27,6 +27,7 @@
 #include "gl/shader_source.h"
 #include "gl/volume_textures.h"
 #include "viewer/render_settings.h"
+#include "viewer/volume_analysis.h"
 
 namespace eik {
 
@@ -60,6 +61,11 @@ struct RaymarchObject {
 // slot count), SLOT_IOR, SLOT_DISPERSION, SLOT_GRADED and SLOT_OPAQUE (vec4 literals, one entry a
 // slot); "" for a table without slots.
 std::string interfaceDefines(const InterfaceTable& table);
+
+// The per-object defines of the constant media of its materials (volume_analysis.h slotMedia):
+// MEDIUM_SIGMA_A(k) (vec3) where σa is constant in every material, MEDIUM_SCATTER(k) (vec2: ω̂, g)
+// where scattering is, k the material the ray is in (−1 air, else the slot); "" where neither is.
+std::string slotMediumDefines(const SlotMedia& media);
 
 // The sampler uniform of object k's receiver map (HAS_RECEIVER).
 std::string objectReceiverSampler(std::size_t object);

@@ -154,6 +154,29 @@ TEST(RaymarchShader, ThreeObjectsEachInItsOwnScope) {
   EXPECT_NE(main_lines[static_cast<std::size_t>(number - 2)].find("@OBJECTS@"), std::string::npos);
 }
 
+TEST(RaymarchShader, ConstantMediaAreSelectsOnTheMaterialAndLeaveWithTheirObject) {
+  SlotMedia media;
+  media.sigma_a_constant = true;
+  media.media = {MaterialMedium{}, MaterialMedium{{1.0, 2.0, 0.5}, {0.25, 0.5}}};
+  EXPECT_EQ(slotMediumDefines(media), "#define MEDIUM_SIGMA_A(k) ((k) == 0 ? vec3(1, 2, 0.5) : vec3(0, 0, 0))\n");
+  media.scatter_constant = true;
+  const std::string both = slotMediumDefines(media);
+  EXPECT_CONTAINS(both, "#define MEDIUM_SCATTER(k) ((k) == 0 ? vec2(0.25, 0.5) : vec2(0, 0))\n");
+  EXPECT_EQ(slotMediumDefines(SlotMedia{}), "");
+  // Two objects each with its own function-like macro: each is #undef'd by its name after its
+  // object (a GLSL preprocessor rejects "#undef NAME(k)" and a redefinition alike).
+  RaymarchObject first = glassObject(), second = glassObject();
+  first.defines = both;
+  second.defines = slotMediumDefines(media);
+  RaymarchScene scene;
+  scene.objects = 2;
+  const gl::ShaderLibrary shaders;
+  const std::string text = raymarchFragmentSource(shaders, raymarchDefines(RenderSettings{}, scene), {first, second}).text;
+  EXPECT_EQ(occurrences(text, "#undef MEDIUM_SIGMA_A\n"), 2u);
+  EXPECT_EQ(occurrences(text, "#undef MEDIUM_SCATTER\n"), 2u);
+  EXPECT_EQ(text.find("#undef MEDIUM_SIGMA_A("), std::string::npos);
+}
+
 TEST(RaymarchShader, NeedsItsSegmentAndAnObject) {
   const gl::ShaderLibrary shaders;
   EXPECT_THROW(raymarchFragmentSource(shaders, {}, {}), RuntimeError);

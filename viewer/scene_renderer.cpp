@@ -122,7 +122,8 @@ struct SceneRenderer::Impl {
     const gl::VolumeFieldSlot* grad = o.textures.layout().find("ior_grad");
     if (!ior || !grad || ior->texture != grad->texture || ior->channel != 0 || grad->channel != 1)
       throw RuntimeError("viewer: expected ior and ior_grad together in one RGBA texture");
-    o.defines = interfaceDefines(interfaceTable(loaded.volume, loaded.source));
+    const InterfaceTable table = interfaceTable(loaded.volume, loaded.source);
+    o.defines = interfaceDefines(table) + slotMediumDefines(slotMedia(loaded.volume, table));
     if (scene.ground) attachReceiver(o, loaded, *scene.ground);
     if (o.has_receiver) o.defines += "#define HAS_RECEIVER 1\n";
     const std::vector<float> bricks = homogeneousBricks(loaded.volume, o.brick_dims);

@@ -2,6 +2,7 @@
 #include "viewer/volume_analysis.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 
@@ -115,6 +116,63 @@ bool absorbingRegion(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi) {
   lo = glm::max(grid.bounds_min, grid.bounds_min + glm::dvec3(imin - 1) * voxel);
   hi = glm::min(grid.bounds_max, grid.bounds_min + glm::dvec3(imax + 2) * voxel);
   return true;
+}
+
+SlotMedia slotMedia(const Volume& volume, const InterfaceTable& table) {
+  SlotMedia result;
+  const Field* interfaces = volume.find("interfaces");
+  if (table.empty() || !interfaces) return result;
+  const int slots = static_cast<int>(table.slots.size());
+  result.media.assign(static_cast<std::size_t>(slots) + 1, MaterialMedium{});
+  const GridSpec& grid = volume.grid;
+  const double depth = kMediumDepthVoxels * std::min({grid.voxelSize().x, grid.voxelSize().y, grid.voxelSize().z});
+  // For one field: each material's value where it is deep inside, and whether it is one value there.
+  auto constantIn = [&](const Field* field, int components, auto&& store) {
+    if (!field) return true;  // absent: 0 everywhere, as the media start
+    std::vector<bool> seen(result.media.size(), false);
+    std::vector<std::array<float, 3>> value(result.media.size());
+    for (std::size_t v = 0; v < grid.count(); ++v) {
+      const float* d = interfaces->voxel(v);
+      glm::dvec4 distances(1e30);
+      bool deep = true;
+      for (int k = 0; k < slots; ++k) {
+        distances[k] = d[k];
+        deep = deep && std::abs(d[k]) >= depth;
+      }
+      if (!deep) continue;
+      const int slot = materialSlot(distances, slots);
+      if (slot >= 0 && table.slots[static_cast<std::size_t>(slot)].opaque) continue;
+      const std::size_t m = static_cast<std::size_t>(slot + 1);
+      const float* x = field->voxel(v);
+      if (!seen[m]) {
+        seen[m] = true;
+        std::copy(x, x + components, value[m].begin());
+        continue;
+      }
+      for (int c = 0; c < components; ++c)
+        if (std::abs(x[c] - value[m][static_cast<std::size_t>(c)]) > 1e-6f * (1.0f + std::abs(value[m][static_cast<std::size_t>(c)])))
+          return false;
+    }
+    for (std::size_t m = 0; m < result.media.size(); ++m) {
+      const bool opaque = m > 0 && table.slots[m - 1].opaque;
+      // A material never met deep inside: unknown, unless it is air (a material that fills the box
+      // leaves no air inside it) or opaque (no ray goes on in it).
+      if (!seen[m] && m > 0 && !opaque) return false;
+      if (seen[m]) store(result.media[m], value[m]);
+    }
+    return true;
+  };
+  result.sigma_a_constant = constantIn(volume.find("sigma_a"), 3, [](MaterialMedium& medium, const std::array<float, 3>& x) {
+    medium.sigma_a = glm::dvec3(x[0], x[1], x[2]);
+  });
+  result.scatter_constant = constantIn(volume.find("scatter"), 2, [](MaterialMedium& medium, const std::array<float, 3>& x) {
+    medium.scatter = glm::dvec2(x[0], x[1]);
+  });
+  if (!result.sigma_a_constant)
+    for (MaterialMedium& m : result.media) m.sigma_a = glm::dvec3(0.0);
+  if (!result.scatter_constant)
+    for (MaterialMedium& m : result.media) m.scatter = glm::dvec2(0.0);
+  return result;
 }
 
 }  // namespace eik

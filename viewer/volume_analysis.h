@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 
+#include "core/interfaces.h"
 #include "core/volume.h"
 
 namespace eik {
@@ -36,5 +37,28 @@ bool materialTouchesBox(const Volume& volume);
 // The box (volume coordinates) of the voxels with σa > 0, one voxel of margin; false when none.
 // Rays fetch σa only inside it (a second texture fetch a step is what absorption costs).
 bool absorbingRegion(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi);
+
+// The medium of each material of a volume with sharp interfaces (air, then each slot of `table`),
+// where it is one constant throughout the material: σa, and the scattering albedo ω̂ and g. A ray
+// between sharp surfaces then knows them from the material it is in (object.glsl, MEDIUM_SIGMA_A
+// and MEDIUM_SCATTER), fetching nothing, and the material's σa and ω̂ end exactly at its surface
+// instead of blending over the voxel beside it. "Throughout" is read from the voxels at least
+// kMediumDepthVoxels from every slot surface, where compositing blends nothing in
+// (voxelize/composite.h mixes regions by coverage only within a voxel of their surfaces); a
+// material with no such voxel (a wall thinner than two voxels), or whose voxels there disagree (two
+// objects of one n and different σa share a slot; smoke in the air), makes the field vary.
+// Opaque slots stop rays and are not looked at.
+constexpr double kMediumDepthVoxels = 1.0;
+struct MaterialMedium {
+  glm::dvec3 sigma_a{0.0};
+  glm::dvec2 scatter{0.0};  // albedo ω̂, Henyey–Greenstein g
+};
+struct SlotMedia {
+  bool sigma_a_constant = false;      // σa is one constant in every material
+  bool scatter_constant = false;      // ω̂ and g likewise
+  std::vector<MaterialMedium> media;  // [0] air, [1 + k] slot k
+};
+// Both false for a volume without sharp interfaces. A field the volume lacks is constant (0).
+SlotMedia slotMedia(const Volume& volume, const InterfaceTable& table);
 
 }  // namespace eik

@@ -1,10 +1,12 @@
 // The viewer's volume analysis on small hand-made volumes: the active region and the absorbing
 // region with their one-voxel margins (clamped to the box), the homogeneous bricks with their
-// margins, and whether the material touches the box.
+// margins, whether the material touches the box, and the constant media of sharp materials.
 #include "viewer/volume_analysis.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -160,6 +162,88 @@ TEST(AbsorbingRegion, IsTheBoxOfPositiveSigmaWithOneVoxelOfMargin) {
   ior(v, 0, 0, 0) = 1.5f;                  // glass does not absorb
   ASSERT_TRUE(absorbingRegion(v, lo, hi));
   expectBox(lo, hi, glm::dvec3(1.0, 2.0, 3.0) + glm::dvec3(1, 2, 3), glm::dvec3(1.0, 2.0, 3.0) + glm::dvec3(6, 5, 8));
+}
+
+// Sharp slabs along x on 16×4×4 unit voxels: slot 0 where x < 6, slot 1 where 6 ≤ x < `outer`
+// (its solid is x < outer, under slot 0), air beyond; the distances of the unused slots are far
+// out. Each material's σa and scatter where it is deep, and a blend of both sides within a voxel
+// of each surface (as compositing mixes them), which slotMedia must not read.
+struct SharpSlabs {
+  Volume volume = air({16, 4, 4});
+  InterfaceTable table;
+  SharpSlabs(glm::vec3 sa0, glm::vec3 sa1, glm::vec2 sc0, glm::vec2 sc1, double outer = 12.0) {
+    table.band = 4.0;
+    table.slots = {InterfaceSlot{"inner", 1.5, 0.0, false, false}, InterfaceSlot{"outer", 1.4, 0.0, false, false}};
+    Field& d = volume.addField("interfaces", 4);
+    Field& sigma = volume.addField("sigma_a", 3);
+    Field& scatter = volume.addField("scatter", 2);
+    for (int k = 0; k < 4; ++k)
+      for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 16; ++i) {
+          const std::size_t v = volume.grid.index(i, j, k);
+          const double x = i + 0.5;
+          const float d0 = static_cast<float>(std::clamp(x - 6.0, -4.0, 4.0));
+          const float d1 = static_cast<float>(std::clamp(x - outer, -4.0, 4.0));
+          d.voxel(v)[0] = d0;
+          d.voxel(v)[1] = d1;
+          d.voxel(v)[2] = d.voxel(v)[3] = 4.0f;
+          const glm::vec3 sa = x < 6 ? sa0 : x < outer ? sa1 : glm::vec3(0.0f);
+          const glm::vec2 sc = x < 6 ? sc0 : x < outer ? sc1 : glm::vec2(0.0f);
+          const bool blended = std::abs(d0) < 1.0f || std::abs(d1) < 1.0f;
+          for (int c = 0; c < 3; ++c) sigma.voxel(v)[c] = blended ? 0.5f * sa[c] + 0.123f : sa[c];
+          for (int c = 0; c < 2; ++c) scatter.voxel(v)[c] = blended ? 0.5f * sc[c] + 0.07f : sc[c];
+        }
+  }
+  float* at(const char* name, int i) { return field(volume, name, i, 1, 2); }
+};
+
+TEST(SlotMedia, AreEachMaterialsConstantsWhereTheyAreOneThroughout) {
+  SharpSlabs slabs({1, 2, 3}, {0.5f, 0, 0}, {0.2f, 0.3f}, {0, 0});
+  const SlotMedia media = slotMedia(slabs.volume, slabs.table);
+  ASSERT_TRUE(media.sigma_a_constant);
+  ASSERT_TRUE(media.scatter_constant);
+  ASSERT_EQ(media.media.size(), 3u);  // air, slot 0, slot 1
+  EXPECT_EQ(media.media[0].sigma_a, glm::dvec3(0.0));
+  EXPECT_EQ(media.media[1].sigma_a, glm::dvec3(1, 2, 3));
+  EXPECT_EQ(media.media[2].sigma_a, glm::dvec3(0.5f, 0, 0));
+  EXPECT_EQ(media.media[1].scatter, glm::dvec2(0.2f, 0.3f));
+  EXPECT_EQ(media.media[2].scatter, glm::dvec2(0.0));
+}
+
+TEST(SlotMedia, VaryWhereAMaterialDisagreesWithItselfOrIsNeverDeep) {
+  {  // one deep voxel of slot 1 with another σa (two objects of one n share the slot)
+    SharpSlabs slabs({1, 2, 3}, {0.5f, 0, 0}, {0.2f, 0.3f}, {0, 0});
+    slabs.at("sigma_a", 9)[2] = 0.25f;
+    const SlotMedia media = slotMedia(slabs.volume, slabs.table);
+    EXPECT_FALSE(media.sigma_a_constant);
+    EXPECT_TRUE(media.scatter_constant);
+    EXPECT_EQ(media.media[1].sigma_a, glm::dvec3(0.0));  // no constants reported for a varying field
+  }
+  {  // smoke in the air: the air scatters in one place
+    SharpSlabs slabs({1, 2, 3}, {0.5f, 0, 0}, {0.2f, 0.3f}, {0, 0});
+    slabs.at("scatter", 14)[0] = 0.35f;
+    const SlotMedia media = slotMedia(slabs.volume, slabs.table);
+    EXPECT_TRUE(media.sigma_a_constant);
+    EXPECT_FALSE(media.scatter_constant);
+  }
+  {  // slot 1 two voxels thick: none of its voxels is a voxel from both surfaces
+    SharpSlabs slabs({1, 2, 3}, {0.5f, 0, 0}, {0.2f, 0.3f}, {0, 0}, 7.5);
+    const SlotMedia media = slotMedia(slabs.volume, slabs.table);
+    EXPECT_FALSE(media.sigma_a_constant);
+    EXPECT_FALSE(media.scatter_constant);
+  }
+  {  // an opaque slot is not read, whatever it holds
+    SharpSlabs slabs({1, 2, 3}, {0.5f, 0, 0}, {0.2f, 0.3f}, {0, 0});
+    slabs.table.slots[0].opaque = true;
+    slabs.at("sigma_a", 1)[0] = 7.0f;
+    EXPECT_TRUE(slotMedia(slabs.volume, slabs.table).sigma_a_constant);
+  }
+  {  // without sharp interfaces there are no materials to know
+    SharpSlabs slabs({1, 2, 3}, {0.5f, 0, 0}, {0.2f, 0.3f}, {0, 0});
+    const SlotMedia media = slotMedia(slabs.volume, InterfaceTable{});
+    EXPECT_FALSE(media.sigma_a_constant);
+    EXPECT_FALSE(media.scatter_constant);
+  }
 }
 
 }  // namespace

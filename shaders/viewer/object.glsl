@@ -48,6 +48,7 @@ struct March@ {
   vec4 dist;        // the slot distances at x (HAS_INTERFACES), fetched where x last moved
   vec3 groundHit;   // where the last step met the ground (world; the ground event)
   vec3 uvwOpaque;   // where the ray met an opaque embedding (the opaque event)
+  float hsLast;     // the length of the step that crossed a sharp surface (the crossing event)
 };
 
 // Radiance of an opaque embedding of diffuse albedo ρ at uvw: ρE/π with the baked irradiance E
@@ -193,6 +194,7 @@ March@ enterVolume@(Ray r, float cauchy) {
   m.dist = volumeInterfaces((m.x - m.bmin) * m.invExtent);
   m.groundHit = vec3(0.0);
   m.uvwOpaque = vec3(0.0);
+  m.hsLast = 0.0;
   m.medium = materialAt@(m.dist);
   vec4 optics = refractiveIndex@((m.x - m.bmin) * m.invExtent, cauchy, m.medium);
   m.n = optics.r;
@@ -345,8 +347,10 @@ bool skipHomogeneousBrick@(inout March@ m, vec3 uvw) {
     toFace = mix(vec3(1e30), toFace, greaterThan(abs(dir), vec3(1e-8)));
     float L = min(min(toFace.x, toFace.y), toFace.z) + 0.01 * m.h;
     if (!m.inLayer) rememberStateBeforeLayer@(m, length(m.w), dir);  // a quiet stretch
-#if defined(ATTENUATION) && defined(HAS_SIGMA_A)
-    m.tau += volumeSigmaA(uvw) * L;  // Beer–Lambert, σa constant here
+#if defined(ATTENUATION) && defined(HAS_SIGMA_A) && defined(MEDIUM_SIGMA_A)
+    m.tau += MEDIUM_SIGMA_A(m.medium) * L;  // Beer–Lambert, σa constant here
+#elif defined(ATTENUATION) && defined(HAS_SIGMA_A)
+    m.tau += volumeSigmaA(uvw) * L;
 #endif
     m.x += dir * L;
 #ifdef HAS_INTERFACES
@@ -404,10 +408,13 @@ void followBoundaryLayer@(inout Ray r, inout March@ m, vec3 grad, float grad2, b
   }
 }
 
-// Beer–Lambert over the step hs (Eq. 3.4, per channel: T = exp(−τ)). σa is fetched only inside
-// the box where it is not 0 (viewer/volume_analysis.h absorbingRegion).
+// Beer–Lambert over the step hs (Eq. 3.4, per channel: T = exp(−τ)). σa is the constant of the
+// material the ray is in where every material has one (MEDIUM_SIGMA_A, volume_analysis.h
+// slotMedia), else fetched, only inside the box where it is not 0 (absorbingRegion).
 void absorb@(inout March@ m, vec3 uvw, float hs) {
-#if defined(ATTENUATION) && defined(HAS_SIGMA_A)
+#if defined(ATTENUATION) && defined(HAS_SIGMA_A) && defined(MEDIUM_SIGMA_A)
+  m.tau += MEDIUM_SIGMA_A(m.medium) * hs;  // constant in the material the ray is in: no fetch
+#elif defined(ATTENUATION) && defined(HAS_SIGMA_A)
   if (all(greaterThanEqual(m.x, uObjAbsorbingMin[@])) && all(lessThanEqual(m.x, uObjAbsorbingMax[@])))
     m.tau += volumeSigmaA(uvw) * hs;
 #endif
@@ -424,12 +431,24 @@ void emit@(inout Ray r, March@ m, vec3 uvw, float hs) {
 // in Eq. 5.10; the 3D-normalised phase function, not Eq. 3.5).
 void inScatter@(inout Ray r, March@ m, vec3 uvw, float hs) {
 #if defined(SCATTERING) && defined(HAS_SCATTER) && defined(HAS_IRRADIANCE) && defined(HAS_LIGHT_DIR)
+#ifdef MEDIUM_SCATTER
+  vec2 scatter = MEDIUM_SCATTER(m.medium);  // constant in the material the ray is in: no fetch
+#else
   vec2 scatter = volumeScatter(uvw);
+#endif
   if (scatter.x > 0.0) {
     vec3 l = volumeLightDir(uvw);
     float cosTheta = dot(l, -normalize(m.w));
+#if defined(ATTENUATION) && defined(HAS_SIGMA_A) && defined(MEDIUM_SIGMA_A)
+    // σa is constant over the step (absorb@ has added its x = σa·hs to τ): the light scattered at
+    // s within it is attenuated by exp(−τ + x − σa·s), and ∫₀^hs of that is exp(−τ)·(eˣ − 1)/σa.
+    vec3 x = MEDIUM_SIGMA_A(m.medium) * hs;
+    vec3 along = hs * mix((exp(x) - 1.0) / max(x, vec3(1e-30)), 1.0 + 0.5 * x, lessThan(x, vec3(1e-3)));
+#else
+    vec3 along = vec3(hs);
+#endif
     r.radiance += r.T * exp(-m.tau) * scatter.x * henyeyGreenstein(scatter.y, cosTheta) *
-                  volumeIrradiance(uvw) * hs;
+                  volumeIrradiance(uvw) * along;
   }
 #endif
 }
@@ -444,15 +463,23 @@ void inScatter@(inout Ray r, March@ m, vec3 uvw, float hs) {
 // by at most one per unit length changes by at most √3 per unit length (|∂d/∂x_i| ≤ 1 on every
 // axis), so no surface lies within nearest/√3 (the field is clamped to ±4 voxels: steps up to
 // 2.3 voxels; SKIP_TO_SURFACES, the viewer's empty-space skipping). σa is taken at the step's
-// start, constant within a material.
+// start, constant within a material. Where scattering must be sampled, it is the same but at most
+// a voxel when every material's ω̂ is a constant (MEDIUM_SCATTER) and the ray is in one that
+// scatters, else the fixed steps above.
 float stepLength@(March@ m, vec3 uvw, float grad2) {
   bool quiet = grad2 <= m.quiet2;
 #ifdef HAS_INTERFACES
   vec4 d = abs(m.dist);  // at m.x
   float nearest = min(min(d.x, d.y), min(d.z, d.w));
-#if defined(SKIP_TO_SURFACES) && defined(CONSTANT_SLOTS) && !(defined(EMISSION) && defined(HAS_EMISSION)) && \
-    !(defined(SCATTERING) && defined(HAS_SCATTER))
+#if defined(SKIP_TO_SURFACES) && defined(CONSTANT_SLOTS) && !(defined(EMISSION) && defined(HAS_EMISSION))
+#if !(defined(SCATTERING) && defined(HAS_SCATTER))
   return max(m.h, nearest * 0.57735);
+#elif defined(MEDIUM_SCATTER)
+  // In a scattering material the baked light is sampled at least once a voxel (2h at the default
+  // step of half a voxel); in the others the ray steps on to the next surface.
+  float reach = max(m.h, nearest * 0.57735);
+  return MEDIUM_SCATTER(m.medium).x > 0.0 ? min(reach, 2.0 * m.h) : reach;
+#endif
 #endif
   quiet = quiet && nearest > 4.0 * m.h;
 #endif
@@ -572,6 +599,9 @@ bool crossInterface@(inout Ray r, inout March@ m, float cauchy) {
     entered = next;
   }
   markDispersed@(r, entered);  // Fresnel at its surface depends on λ too, whichever way the ray goes
+  // The medium from the step's start to the surface (the march gathers no step that crosses one:
+  // the part beyond the surface is walked again in the material there).
+  gatherMedium@(r, m, (x0 - m.bmin) * m.invExtent, best * m.hsLast);
   vec3 p = mix(x0, x1, best);
   m.x = p;
   m.dist = volumeInterfaces((p - m.bmin) * m.invExtent);
@@ -692,9 +722,10 @@ void march@(inout Ray r, float cauchy) {
       float hs = stepLength@(m, uvw, grad2);
       if (metOpaque@(m, uvw)) { event = EVENT_OPAQUE; break; }
       followBoundaryLayer@(r, m, grad, grad2, grad2 <= m.quiet2, uvw);
-      gatherMedium@(r, m, uvw, hs);
       stepRay@(m, grad, hs, cauchy);
-      if (materialChanged@(m)) { event = EVENT_CROSSING; break; }
+      // A step that crossed a surface is gathered up to it only, by crossInterface@.
+      if (materialChanged@(m)) { event = EVENT_CROSSING; m.hsLast = hs; break; }
+      gatherMedium@(r, m, uvw, hs);
       if (absorbed@(r, m)) break;
     }
     if (event == EVENT_NONE) break;
