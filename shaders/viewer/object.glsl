@@ -41,9 +41,9 @@ struct March@ {
   vec3 bmin, invExtent;
   float h;
   float threshold2, quiet2;  // |∇n|² where a boundary layer begins, and where it ends
-  vec3 groundPoint, groundNormal;
-  float side;       // height above the ground at the last sample
-  vec3 xPrev;       // position at the last sample
+  vec3 groundNormal;
+  float groundOffset;  // the ground is {x : x·groundNormal = groundOffset}
+  bool groundPassed;   // found below the ground's plane once (belowGround@, metGround@)
   int medium;       // sharp interfaces (HAS_INTERFACES): the material slot the ray is in, −1 air
   vec4 dist;        // the slot distances at x (HAS_INTERFACES), fetched where x last moved
   vec3 groundHit;   // where the last step met the ground (world; the ground event)
@@ -212,10 +212,11 @@ March@ enterVolume@(Ray r, float cauchy) {
   m.threshold2 = uObjBoundaryGrad[@] * uObjBoundaryGrad[@];
   m.quiet2 = m.threshold2 * (1.0 / 256.0);
 #ifdef GROUND
-  m.groundPoint = (toVolume * vec4(uGroundPoint, 1.0)).xyz;
-  m.groundNormal = normalize(mat3(toVolume) * uGroundNormal);
-  m.side = dot(m.x - m.groundPoint, m.groundNormal);
-  m.xPrev = m.x;
+  // A plane goes to a plane: the normal by the inverse transpose (M⁻ᵀ of toVolume is the
+  // transpose of toWorld's linear part), the offset through a point of it.
+  m.groundNormal = normalize(transpose(mat3(uObjVolToWorld[@])) * uGroundNormal);
+  m.groundOffset = dot((toVolume * vec4(uGroundPoint, 1.0)).xyz, m.groundNormal);
+  m.groundPassed = false;
 #endif
   return m;
 }
@@ -262,25 +263,40 @@ vec3 branchRadiance@(vec3 pVol, vec3 dVol) {
   return environmentRadiance(dw, uReflectionLod);
 }
 
-// Whether the last step crossed the ground (GROUND) from above inside the volume, and where
-// (m.groundHit; checked before leaving the box, as the last step may do both); shadeGround@ ends
-// the ray there. With sharp interfaces the ground is met from the air only: inside a material the height is not
-// followed, so a face resting on the ground decides first (Fresnel, total internal reflection) and
-// the ray meets the ground once it has left the face downwards; the face is found to a fraction of
-// a voxel, a hair above or below the plane, which must not decide whether a reflection happens.
-bool crossedGround@(inout March@ m) {
+// Whether the ray, in air, is below the ground plane (GROUND) and has not been found below it
+// before: the one test a step makes (a dot product), the crossing itself is metGround@'s. With sharp
+// interfaces the ground is met from the air only: inside a material the height is not followed,
+// so a face resting on the ground decides first (Fresnel, total internal reflection) and the ray
+// meets the ground once it has left the face downwards; the face is found to a fraction of a
+// voxel, a hair above or below the plane, which must not decide whether a reflection happens.
+bool belowGround@(March@ m) {
 #ifdef GROUND
 #ifdef HAS_INTERFACES
-  if (m.medium >= 0) return false;
+  bool inAir = m.medium < 0;
+#else
+  bool inAir = true;
 #endif
-  float s = dot(m.x - m.groundPoint, m.groundNormal);
-  if (m.side > 0.0 && s <= 0.0) {
-    vec3 hit = mix(m.xPrev, m.x, m.side / (m.side - s));
+  return inAir && !m.groundPassed && dot(m.x, m.groundNormal) <= m.groundOffset;
+#else
+  return false;
+#endif
+}
+
+// The ground event: whether the last step (from m.xStepStart to m.x) came down through the
+// ground's plane onto the ground itself, and where (m.groundHit, world); shadeGround@ ends the
+// ray there. Otherwise (the step began below the plane, or the plane is crossed beyond the
+// ground's extent) the ray goes on and the plane is not looked at again in this object: a ray
+// below it does not come back up and down onto it (steps are straight in air).
+bool metGround@(inout March@ m) {
+#ifdef GROUND
+  m.groundPassed = true;
+  float s0 = dot(m.xStepStart, m.groundNormal) - m.groundOffset;
+  float s1 = dot(m.x, m.groundNormal) - m.groundOffset;
+  if (s0 > 0.0) {
+    vec3 hit = mix(m.xStepStart, m.x, s0 / (s0 - s1));
     m.groundHit = (uObjVolToWorld[@] * vec4(hit, 1.0)).xyz;
-    if (onGround(m.groundHit)) return true;
+    return onGround(m.groundHit);
   }
-  m.side = s;
-  m.xPrev = m.x;
 #endif
   return false;
 }
@@ -352,6 +368,7 @@ bool skipHomogeneousBrick@(inout March@ m, vec3 uvw) {
 #elif defined(ATTENUATION) && defined(HAS_SIGMA_A)
     m.tau += volumeSigmaA(uvw) * L;
 #endif
+    m.xStepStart = m.x;  // a step like any other for the events after it (the ground, a sharp face)
     m.x += dir * L;
 #ifdef HAS_INTERFACES
     m.dist = volumeInterfaces((m.x - m.bmin) * m.invExtent);
@@ -711,7 +728,7 @@ void march@(inout Ray r, float cauchy) {
   for (int pass = 0; pass < kMaxEventsPerObject && steps < uObjMaxSteps[@]; ++pass) {
     int event = EVENT_NONE;
     for (; steps < uObjMaxSteps[@]; ++steps) {
-      if (crossedGround@(m)) { event = EVENT_GROUND; break; }
+      if (belowGround@(m)) { event = EVENT_GROUND; break; }
       if (leftActiveRegion@(m)) { event = EVENT_LEFT; break; }
       vec3 uvw = (m.x - m.bmin) * m.invExtent;
       if (skipHomogeneousBrick@(m, uvw)) continue;
@@ -729,7 +746,10 @@ void march@(inout Ray r, float cauchy) {
       if (absorbed@(r, m)) break;
     }
     if (event == EVENT_NONE) break;
-    if (event == EVENT_GROUND) { shadeGround@(r, m); break; }
+    if (event == EVENT_GROUND) {
+      if (metGround@(m)) { shadeGround@(r, m); break; }
+      continue;  // below the plane beyond the ground, or from below: on
+    }
     if (event == EVENT_OPAQUE) { shadeOpaque@(r, m); break; }
     ++steps;  // the step that ended the run, or the one a reflection takes again
     if (event == EVENT_LEFT && !reflectedAtSharpFace@(r, m)) break;  // total internal reflection: on
