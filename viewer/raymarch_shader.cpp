@@ -94,6 +94,7 @@ gl::ShaderDefines raymarchDefines(const RenderSettings& settings, const Raymarch
   d.emplace_back("MAX_SEGMENTS", std::to_string(2 * scene.objects + 1));
   d.emplace_back("LIGHT_COUNT", std::to_string(std::min(scene.lights, kMaxLights)));
   if (settings.ground && scene.ground) d.emplace_back("GROUND", "1");
+  if (settings.ground && scene.ground && scene.ground_map) d.emplace_back("GROUND_MAP", "1");
   if (settings.fresnel) d.emplace_back("FRESNEL", "1");
   if (settings.attenuation) d.emplace_back("ATTENUATION", "1");
   if (settings.emission) d.emplace_back("EMISSION", "1");

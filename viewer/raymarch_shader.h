@@ -39,12 +39,13 @@ struct RaymarchScene {
   std::size_t objects = 1;
   std::size_t lights = 0;           // the scene's; the shader takes kMaxLights at most
   bool ground = false;              // the scene has a ground plane
+  bool ground_map = false;          // and a ground map (ground_map.h: two or more receiver maps)
   bool dispersive = false;          // some object's volume has a dispersion field
   gl::ShaderDefines environment;    // Environment::defines()
 };
 
 // The program-wide defines: OBJECT_COUNT, MAX_SEGMENTS, LIGHT_COUNT, the terms of Eq. 5.10 that
-// are on (GROUND, FRESNEL, ATTENUATION, EMISSION, SCATTERING, DISPERSION), NO_REFRACTION, RK4,
+// are on (GROUND, FRESNEL, ATTENUATION, EMISSION, SCATTERING, DISPERSION), GROUND_MAP, NO_REFRACTION, RK4,
 // SKIP_HOMOGENEOUS, OUTPUT_EXIT_POSITION / OUTPUT_EXIT_DIRECTION and the environment's ENV_*.
 gl::ShaderDefines raymarchDefines(const RenderSettings& settings, const RaymarchScene& scene);
 

@@ -15,6 +15,7 @@
 #include "gl/vertex_array.h"
 #include "gl/volume_textures.h"
 #include "viewer/environment.h"
+#include "viewer/ground_map.h"
 #include "viewer/raymarch_shader.h"
 #include "viewer/volume_analysis.h"
 
@@ -61,6 +62,10 @@ struct SceneRenderer::Impl {
   Environment environment;
   glm::dvec3 light_direction{0.0, -1.0, 0.0};
   glm::vec3 sun_irradiance{0.0f};
+  // The ground map (ground_map.h) where two or more objects have a receiver map.
+  bool has_ground_map = false;
+  GroundMap ground_map;  // geometry (the data is in ground_texture)
+  gl::Texture2D ground_texture;
   gl::Program program;
   std::string program_key;  // the defines the program was built with
   gl::FullscreenTriangle triangle;
@@ -93,8 +98,7 @@ struct SceneRenderer::Impl {
       } catch (const nlohmann::json::exception&) {
         throw InputError(loaded.source, "light", "the baked light is malformed");
       }
-      o.receiver = map;
-      o.receiver.irradiance.clear();
+      o.receiver = map;  // with its irradiance, for the ground map
       o.receiver_texture = gl::Texture2D(map.texels, gl::TextureFormat::RGBA32F, padRgba(map.irradiance), 4);
       o.has_receiver = true;
       return;
@@ -136,9 +140,37 @@ struct SceneRenderer::Impl {
     variant.objects = objects.size();
     variant.lights = scene.lights.size();
     variant.ground = scene.ground.has_value();
+    variant.ground_map = has_ground_map;
     variant.dispersive = std::any_of(objects.begin(), objects.end(), [](const Object& o) { return o.has_dispersion; });
     variant.environment = environment.defines();
     return raymarchDefines(settings, variant);
+  }
+
+  // The ground's in-plane axes (raymarch.frag onGround, GROUND_MAP).
+  static void groundAxes(const glm::dvec3& normal, glm::dvec3& u, glm::dvec3& v) {
+    const glm::dvec3 helper = std::abs(normal.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+    u = glm::normalize(glm::cross(helper, normal));
+    v = glm::cross(normal, u);
+  }
+
+  // Two or more receiver maps: their changes summed on one lattice, so the ground is shaded with
+  // one lookup (ground_map.h); one map is read directly.
+  void buildGroundMap() {
+    has_ground_map = false;
+    ground_texture = gl::Texture2D();
+    if (!scene.ground) return;
+    std::vector<ReceiverLayer> layers;
+    for (const Object& o : objects)
+      if (o.has_receiver)
+        layers.push_back({&o.receiver, o.to_volume, o.to_world, glm::dvec4(o.receiver_light_pos), glm::dvec3(o.receiver_light_power)});
+    if (layers.size() < 2) return;
+    glm::dvec3 u, v;
+    const glm::dvec3 normal = glm::normalize(scene.ground->normal);
+    groundAxes(normal, u, v);
+    ground_map = combineReceiverMaps(layers, scene.ground->point, u, v);
+    ground_texture = gl::Texture2D(ground_map.texels, gl::TextureFormat::RGBA32F, ground_map.rgba, 4);
+    ground_map.rgba.clear();
+    has_ground_map = true;
   }
 
   void buildProgram() {
@@ -230,9 +262,8 @@ struct SceneRenderer::Impl {
     if (scene.ground) {
       const SceneGroundSpec& g = *scene.ground;
       const glm::dvec3 normal = glm::normalize(g.normal);
-      const glm::dvec3 helper = std::abs(normal.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
-      const glm::dvec3 u = glm::normalize(glm::cross(helper, normal));
-      const glm::dvec3 v = glm::cross(normal, u);
+      glm::dvec3 u, v;
+      groundAxes(normal, u, v);
       p.set("uGroundPoint", glm::vec3(g.point));
       p.set("uGroundNormal", glm::vec3(normal));
       p.set("uGroundAxisU", glm::vec3(u));
@@ -240,6 +271,13 @@ struct SceneRenderer::Impl {
       p.set("uGroundHalfExtent", static_cast<float>(g.half_extent));
       p.set("uGroundAlbedo", glm::vec3(g.albedo));
       p.set("uGroundAmbient", glm::vec3(g.albedo) * environment.diffuseRadiance(normal, light_direction));
+      if (has_ground_map) {
+        ground_texture.bind(unit);
+        p.setSampler("uGroundMap", unit);
+        ++unit;
+        p.set("uGroundMapOrigin", glm::vec2(ground_map.origin));
+        p.set("uGroundMapSize", glm::vec2(ground_map.size()));
+      }
     }
     p.set("uEnvLodBias", static_cast<float>(settings.environment_lod_bias));
     p.set("uReflectionLod", static_cast<float>(std::max(0.0, settings.environment_lod_bias)));
@@ -260,6 +298,8 @@ SceneRenderer::SceneRenderer(const gl::ShaderLibrary& shaders, const LoadedScene
     units += o.textures.layout().textureCount() + 1 + (o.has_receiver ? 1 : 0);
     s.objects.push_back(std::move(o));
   }
+  s.buildGroundMap();
+  if (s.has_ground_map) ++units;
   if (units > max_units)
     throw InputError(scene.source, "objects",
                      "the objects' volumes need " + std::to_string(units) + " textures, more than the " +
@@ -296,11 +336,14 @@ void SceneRenderer::replaceVolume(int index, const LoadedObject& object) {
   const bool same_shader = replacement.defines == old.defines && replacement.sharp_faces == old.sharp_faces &&
                            replacement.textures.layout().glslDefines() == old.textures.layout().glslDefines();
   old = std::move(replacement);
+  s.buildGroundMap();  // its receiver map changed with its bake
   if (!same_shader) s.program_key.clear();  // buildProgram compiles anew
   s.buildProgram();
 }
 
 int SceneRenderer::objectCount() const { return static_cast<int>(impl_->objects.size()); }
+
+bool SceneRenderer::usesGroundMap() const { return impl_->has_ground_map; }
 
 void SceneRenderer::draw(const Camera& camera, glm::ivec2 size) {
   impl_->setUniforms(camera, size);

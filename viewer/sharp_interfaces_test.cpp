@@ -3,6 +3,7 @@
 // ground's radiance ρE/π from the map the bake wrote.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -150,10 +151,8 @@ TEST_F(SharpViewerTest, SteppingToTheNextSurfaceChangesNothing) {
   }
 }
 
-// The ground of a scene whose object was baked with a receiver map: in the sunlight beside the
-// object and in its shadow and caustic alike, a pixel's radiance is ρ/π times the map's planar
-// irradiance there (the environment black, so nothing else adds).
-TEST_F(SharpViewerTest, TheGroundShowsTheReceiverMap) {
+// A glass sphere over a floor, baked with a receiver map under a light straight down (1 W/m²).
+Volume bakedSphereOverAFloor() {
   Volume volume = sharpVolume("procedural:sphere,r=0.3,center=0:0.5:0,ior=1.5", 32, box({-0.4, 0.1, -0.4}, {0.4, 0.9, 0.4}));
   CpuSimulator sim(volume);
   LightSpec light;  // straight down, 1 W/m²
@@ -164,52 +163,109 @@ TEST_F(SharpViewerTest, TheGroundShowsTheReceiverMap) {
   options.receiver = floor;
   const BakeResult bake = sim.run(light, options);
   applyBake(volume, bake, light);
-  const ReceiverMap& map = volume.receivers.at(0);
+  return volume;
+}
 
+// The map's planar irradiance at `point` (its volume space), filtered as the texture is: bilinear
+// between texel centres, clamped at the edges. −1 where the map does not reach.
+double mapIrradiance(const ReceiverMap& map, const glm::dvec3& point) {
+  const glm::dvec2 uv = map.planeCoordinates(point) - map.origin;
+  if (uv.x < 0 || uv.y < 0 || uv.x > map.texels.x * map.pitch || uv.y > map.texels.y * map.pitch) return -1.0;
+  const glm::dvec2 st = uv / map.pitch - 0.5;
+  const int i0 = static_cast<int>(std::floor(st.x)), j0 = static_cast<int>(std::floor(st.y));
+  const double fx = st.x - i0, fy = st.y - j0;
+  auto texel = [&](int i, int j) {
+    i = std::clamp(i, 0, map.texels.x - 1);
+    j = std::clamp(j, 0, map.texels.y - 1);
+    return static_cast<double>(map.irradiance[3 * (static_cast<std::size_t>(j) * map.texels.x + i)]);
+  };
+  return (1 - fx) * (1 - fy) * texel(i0, j0) + fx * (1 - fy) * texel(i0 + 1, j0) + (1 - fx) * fy * texel(i0, j0 + 1) +
+         fx * fy * texel(i0 + 1, j0 + 1);
+}
+
+// The radiance of the ground at `point` (world, y = 0), seen from the side and low, so that the
+// ray meets the ground before any object's box: a camera 0.3 away along a slant, a narrow field.
+float groundPixel(SceneRenderer& renderer, const glm::dvec3& point) {
+  const glm::dvec3 dir = glm::normalize(glm::dvec3(0.0, -0.05, -1.0));
+  return renderer.render(lookAlong(point - 0.3 * dir, dir, 0.05), {3, 3}).at(1, 1)[0];
+}
+
+Scene floorScene(int objects) {
   Scene scene;
-  scene.objects.push_back({});
   SceneGroundSpec ground;
-  ground.half_extent = 0.6;
+  ground.half_extent = 2.0;
   ground.albedo = glm::dvec3(0.5);
   scene.ground = ground;
-  scene.lights.push_back(SceneLightSpec{});  // the light it was baked with
+  scene.lights.push_back(SceneLightSpec{});  // the light the objects were baked with
   scene.environment.uniform = glm::dvec3(0.0);
-  LoadedScene loaded = sceneFromVolumes(scene, {volume});
+  for (int k = 0; k < objects; ++k) scene.objects.push_back({});
+  return scene;
+}
+
+// The ground of a scene whose object was baked with a receiver map: in the sunlight beside the
+// object and in its shadow and caustic alike, a pixel's radiance is ρ/π times the map's planar
+// irradiance there (the environment black, so nothing else adds).
+TEST_F(SharpViewerTest, TheGroundShowsTheReceiverMap) {
+  const Volume volume = bakedSphereOverAFloor();
+  const ReceiverMap& map = volume.receivers.at(0);
+  LoadedScene loaded = sceneFromVolumes(floorScene(1), {volume});
   SceneRenderer renderer(*shaders_, loaded, RenderSettings{});
-  // Look at the ground from below the object's box's side, at a point beside the sphere and in its
-  // shadow: a camera far away along a slant, narrow field, so the centre pixel's ray is known.
-  struct Probe {
-    double x, z;
-  };
+  EXPECT_FALSE(renderer.usesGroundMap());  // one map is read directly
   int checked = 0;
-  for (const Probe& probe : {Probe{0.45, 0.0}, Probe{0.2, 0.15}, Probe{0.05, 0.0}, Probe{-0.5, -0.5}, Probe{0.0, 0.28}}) {
-    const glm::dvec3 point(probe.x, 0.0, probe.z);
-    // From the side, low, so the ray meets the ground before the sphere's box.
-    const glm::dvec3 dir = glm::normalize(glm::dvec3(0.0, -0.05, -1.0));
-    const Image image = renderer.render(lookAlong(point - 0.3 * dir, dir, 0.05), {3, 3});
-    const float* pixel = image.at(1, 1);
-    // The map, filtered as the texture is (bilinear between texel centres).
-    const glm::dvec2 st = (map.planeCoordinates(point) - map.origin) / map.pitch - 0.5;
-    const int i0 = static_cast<int>(std::floor(st.x)), j0 = static_cast<int>(std::floor(st.y));
-    const double fx = st.x - i0, fy = st.y - j0;
-    auto texel = [&](int i, int j) {
-      i = std::clamp(i, 0, map.texels.x - 1);
-      j = std::clamp(j, 0, map.texels.y - 1);
-      return static_cast<double>(map.irradiance[3 * (static_cast<std::size_t>(j) * map.texels.x + i)]);
-    };
-    const double E = (1 - fx) * (1 - fy) * texel(i0, j0) + fx * (1 - fy) * texel(i0 + 1, j0) +
-                     (1 - fx) * fy * texel(i0, j0 + 1) + fx * fy * texel(i0 + 1, j0 + 1);
+  for (const glm::dvec2 probe : {glm::dvec2(0.45, 0.0), glm::dvec2(0.2, 0.15), glm::dvec2(0.05, 0.0),
+                                 glm::dvec2(-0.5, -0.5), glm::dvec2(0.0, 0.28)}) {
+    const glm::dvec3 point(probe.x, 0.0, probe.y);
+    const float pixel = groundPixel(renderer, point);
+    const double E = mapIrradiance(map, point);
     const double expected = 0.5 * E / std::numbers::pi;
-    std::printf("ground at (%.2f, %.2f): radiance %.5f, ρE/π from the map %.5f (E %.4f)\n", probe.x, probe.z, pixel[0],
+    std::printf("ground at (%.2f, %.2f): radiance %.5f, ρE/π from the map %.5f (E %.4f)\n", probe.x, probe.y, pixel,
                 expected, E);
     // 1 %, the bound (float texture and interpolation agree far better); an absolute
     // floor for the shadow, where E is small.
-    EXPECT_NEAR(pixel[0], expected, 0.01 * expected + 1e-5);
+    EXPECT_NEAR(pixel, expected, 0.01 * expected + 1e-5);
     ++checked;
   }
   EXPECT_EQ(checked, 5);
 }
 
+// Two such spheres side by side (x = ±0.4, their maps overlapping in |x| < 0.2): the ground is
+// shaded from one ground map, and shows at every point the direct light changed by each map that
+// reaches it — its irradiance less the 1 W/m² it was baked with — in their overlap, in either
+// shadow and caustic, and beyond both maps.
+TEST_F(SharpViewerTest, TheGroundSumsWhatEveryReceiverMapChanges) {
+  const Volume volume = bakedSphereOverAFloor();
+  const ReceiverMap& map = volume.receivers.at(0);
+  // Translations by whole texels: the ground map's lattice is then each map's own, and its
+  // bilinear filter reproduces each exactly (ground_map.h), so the 1 % bound of one map holds.
+  const double shift = std::round(0.4 / map.pitch) * map.pitch;
+  Scene scene = floorScene(2);
+  scene.objects[0].translate = glm::dvec3(-shift, 0.0, 0.0);
+  scene.objects[1].translate = glm::dvec3(shift, 0.0, 0.0);
+  LoadedScene loaded = sceneFromVolumes(scene, {volume, volume});
+  SceneRenderer renderer(*shaders_, loaded, RenderSettings{});
+  ASSERT_TRUE(renderer.usesGroundMap());
+  int overlapped = 0;
+  for (const glm::dvec2 probe : {glm::dvec2(0.0, 0.0), glm::dvec2(0.12, 0.05), glm::dvec2(-0.15, -0.2),
+                                 glm::dvec2(0.4, 0.0), glm::dvec2(-0.65, 0.1), glm::dvec2(0.62, 0.2),
+                                 glm::dvec2(1.3, 0.0)}) {
+    const glm::dvec3 point(probe.x, 0.0, probe.y);
+    double E = 1.0;  // the direct light
+    int covering = 0;
+    for (double x : {-shift, shift}) {
+      const double mapped = mapIrradiance(map, point - glm::dvec3(x, 0.0, 0.0));
+      if (mapped < 0) continue;
+      E += mapped - 1.0;
+      ++covering;
+    }
+    overlapped += covering == 2;
+    const float pixel = groundPixel(renderer, point);
+    const double expected = 0.5 * E / std::numbers::pi;
+    std::printf("two maps: ground at (%.2f, %.2f), %d maps: radiance %.5f, ρE/π %.5f\n", probe.x, probe.y, covering,
+                pixel, expected);
+    EXPECT_NEAR(pixel, expected, 0.01 * expected + 1e-5) << probe.x << ", " << probe.y;
+  }
+  EXPECT_GE(overlapped, 3);
+}
 
 // A glass block resting on a black ground, seen through its front face from above: every ray that
 // enters the vertical face reaches the bottom at 62.7° from its normal, past the critical angle

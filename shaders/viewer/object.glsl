@@ -432,7 +432,8 @@ void absorb@(inout March@ m, vec3 uvw, float hs) {
 #if defined(ATTENUATION) && defined(HAS_SIGMA_A) && defined(MEDIUM_SIGMA_A)
   m.tau += MEDIUM_SIGMA_A(m.medium) * hs;  // constant in the material the ray is in: no fetch
 #elif defined(ATTENUATION) && defined(HAS_SIGMA_A)
-  if (all(greaterThanEqual(m.x, uObjAbsorbingMin[@])) && all(lessThanEqual(m.x, uObjAbsorbingMax[@])))
+  // Where the step began (gatherMedium@ runs once the step is taken): uvw's point.
+  if (all(greaterThanEqual(m.xStepStart, uObjAbsorbingMin[@])) && all(lessThanEqual(m.xStepStart, uObjAbsorbingMax[@])))
     m.tau += volumeSigmaA(uvw) * hs;
 #endif
 }
@@ -504,7 +505,9 @@ float stepLength@(March@ m, vec3 uvw, float grad2) {
 }
 
 // What the medium does over the step hs: one term of the sum of Eq. 5.10 with
-// L_c = ω̂·L_s + L_e (Eq. 5.4; δ·R·L_r comes at the boundaries), and its attenuation.
+// L_c = ω̂·L_s + L_e (Eq. 5.4; δ·R·L_r comes at the boundaries), and its attenuation, sampled at
+// uvw, the step's start (m.xStepStart: it runs after the step, once the step is known not to
+// cross a sharp surface, or from crossInterface@ up to the surface).
 void gatherMedium@(inout Ray r, inout March@ m, vec3 uvw, float hs) {
   absorb@(m, uvw, hs);
   emit@(r, m, uvw, hs);

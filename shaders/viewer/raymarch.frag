@@ -64,6 +64,13 @@ uniform vec3 uGroundAxisV;
 uniform float uGroundHalfExtent;
 uniform vec3 uGroundAlbedo;
 uniform vec3 uGroundAmbient;      // albedo × the environment's diffuse radiance on the ground
+#ifdef GROUND_MAP
+// The ground map (viewer/ground_map.h): every object's receiver map's change (rgb) summed on one
+// lattice of the ground's plane (axes uGroundAxisU/V from uGroundPoint), a = 1 where a map reaches.
+uniform sampler2D uGroundMap;
+uniform vec2 uGroundMapOrigin;    // (u, v) of its corner
+uniform vec2 uGroundMapSize;      // its extent in u and v
+#endif
 #endif
 
 in vec2 vUv;
@@ -160,7 +167,18 @@ vec3 groundRadiance(vec3 xw) {
   vec3 E = unoccludedIrradiance(xw, uGroundNormal);
   bool mapped = false;
   vec3 change;
+#ifdef GROUND_MAP
+  // Two or more receiver maps: their sum, one lookup.
+  vec3 q = xw - uGroundPoint;
+  vec2 st = (vec2(dot(q, uGroundAxisU), dot(q, uGroundAxisV)) - uGroundMapOrigin) / uGroundMapSize;
+  if (all(greaterThanEqual(st, vec2(0.0))) && all(lessThanEqual(st, vec2(1.0)))) {
+    vec4 sum = texture(uGroundMap, st);
+    E += sum.rgb;
+    mapped = sum.a > 0.0;
+  }
+#else
   if (receiverChange@(xw, change)) { E += change; mapped = true; }  // @EACH_OBJECT@
+#endif
   if (!mapped) {
     vec3 baked;
     float weight = bakedGroundIrradiance(xw, baked);
