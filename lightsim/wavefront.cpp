@@ -65,6 +65,29 @@ inline Out interpolate(const std::vector<T>& data, const GridSpec& g, const Taps
   return (c00 * gy + c10 * fy) * gz + (c01 * gy + c11 * fy) * fz;
 }
 
+// interpolate for S < 4 floats a voxel (the used slots' distances), the rest of the vec4 `rest`:
+// the same weights and the same order of sums per component, so the same values as the vec4's.
+template <int S>
+inline glm::dvec4 interpolateUsed(const std::vector<float>& data, float rest, const GridSpec& g, const Taps3& t) {
+  const std::size_t nx = static_cast<std::size_t>(g.dims.x);
+  const std::size_t nxy = nx * static_cast<std::size_t>(g.dims.y);
+  const std::size_t y0 = static_cast<std::size_t>(t.y.i0) * nx, y1 = static_cast<std::size_t>(t.y.i1) * nx;
+  const std::size_t z0 = static_cast<std::size_t>(t.z.i0) * nxy, z1 = static_cast<std::size_t>(t.z.i1) * nxy;
+  const std::size_t x0 = static_cast<std::size_t>(t.x.i0), x1 = static_cast<std::size_t>(t.x.i1);
+  const double fx = t.x.f, fy = t.y.f, fz = t.z.f;
+  const double gx = 1.0 - fx, gy = 1.0 - fy, gz = 1.0 - fz;
+  glm::dvec4 out(static_cast<double>(rest));
+  for (int k = 0; k < S; ++k) {
+    auto at = [&](std::size_t i) { return static_cast<double>(data[i * S + static_cast<std::size_t>(k)]); };
+    const double c00 = at(x0 + y0 + z0) * gx + at(x1 + y0 + z0) * fx;
+    const double c10 = at(x0 + y1 + z0) * gx + at(x1 + y1 + z0) * fx;
+    const double c01 = at(x0 + y0 + z1) * gx + at(x1 + y0 + z1) * fx;
+    const double c11 = at(x0 + y1 + z1) * gx + at(x1 + y1 + z1) * fx;
+    out[k] = (c00 * gy + c10 * fy) * gz + (c01 * gy + c11 * fy) * fz;
+  }
+  return out;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -111,6 +134,16 @@ VolumeSampler::VolumeSampler(const Volume& volume) : grid_(volume.grid), h_(voxe
     const Field& d = volume.require("interfaces", 4);
     distances_.resize(n);
     for (std::size_t i = 0; i < n; ++i) distances_[i] = glm::vec4(d.voxel(i)[0], d.voxel(i)[1], d.voxel(i)[2], d.voxel(i)[3]);
+    const int used = slotCount();
+    bool unused_constant = true;
+    unused_distance_ = used < 4 ? d.voxel(0)[used] : 0.0f;
+    for (std::size_t i = 0; i < n && unused_constant; ++i)
+      for (int k = used; k < 4; ++k) unused_constant = unused_constant && d.voxel(i)[k] == unused_distance_;
+    if (unused_constant && used < 4) {
+      used_distances_.resize(n * static_cast<std::size_t>(used));
+      for (std::size_t i = 0; i < n; ++i)
+        for (int k = 0; k < used; ++k) used_distances_[i * static_cast<std::size_t>(used) + static_cast<std::size_t>(k)] = d.voxel(i)[k];
+    }
   }
   if (const Field* sa = volume.find("sigma_a")) {
     if (sa->components != 3) throw InputError("volume", "sigma_a", "expected 3 components");
@@ -132,7 +165,13 @@ glm::dvec4 VolumeSampler::iorAndGradient(const glm::dvec3& world) const {
 
 glm::dvec4 VolumeSampler::distances(const glm::dvec3& world) const {
   if (distances_.empty()) return glm::dvec4(0.0);
-  return interpolate<glm::dvec4>(distances_, grid_, taps3(grid_, world, grid_.extent()));
+  const Taps3 taps = taps3(grid_, world, grid_.extent());
+  switch (used_distances_.empty() ? 4 : slotCount()) {
+    case 1: return interpolateUsed<1>(used_distances_, unused_distance_, grid_, taps);
+    case 2: return interpolateUsed<2>(used_distances_, unused_distance_, grid_, taps);
+    case 3: return interpolateUsed<3>(used_distances_, unused_distance_, grid_, taps);
+    default: return interpolate<glm::dvec4>(distances_, grid_, taps);
+  }
 }
 
 glm::dvec4 VolumeSampler::materialOptics(int slot, const glm::dvec3& world) const {

@@ -138,6 +138,11 @@ class VolumeSampler {
   std::vector<glm::vec3> sigma_a_;   // empty: no absorption
   InterfaceTable table_;
   std::vector<glm::vec4> distances_; // empty without sharp interfaces
+  // The used slots' distances alone, slotCount() floats a voxel (a quarter of distances_ for one
+  // slot: the lookup every corner makes each step reads that much less memory), with the unused
+  // slots' one value; empty where those vary (then distances_ is read).
+  std::vector<float> used_distances_;
+  float unused_distance_ = 0.0f;
 };
 
 // ---------------------------------------------------------------------------------------------
