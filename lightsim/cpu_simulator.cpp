@@ -359,7 +359,9 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
   const glm::dvec3 m_new = patch.midpoint();
   const glm::dvec3 d_new = patch.direction();
   if (sharp) {
-    samples.n_mid = sampler.materialOptics(sampler.materialAt(m_new), m_new).x;
+    // After a flight the midpoint is in the corners' material (the swept box was quiet: one
+    // material, constant optics), so its n is theirs, with no lookup.
+    samples.n_mid = flight > 0.0 ? samples.corner[0].x : sampler.materialOptics(sampler.materialAt(m_new), m_new).x;
     patch.t_fresnel = crossing.transmittance;
     if (crossing.transmittance < 1.0) {
       result.reflected = patch.flux * (1.0 - crossing.transmittance);
