@@ -47,9 +47,10 @@ inline Taps3 taps3(const GridSpec& g, const glm::dvec3& p, const glm::dvec3& ext
           axisTap(p.z, g.bounds_min.z, extent.z, g.dims.z)};
 }
 
-// Σ weight·data[index] over the eight taps, for any T with T*double and T+T (glm vectors).
-template <typename Out, typename T>
-inline Out interpolate(const std::vector<T>& data, const GridSpec& g, const Taps3& t) {
+// Σ weight·at(index) over the eight taps, for any Out with Out*double and Out+Out (double, glm
+// vectors); at(i) is voxel i's value.
+template <typename Out, typename At>
+inline Out blendTaps(const GridSpec& g, const Taps3& t, At&& at) {
   const std::size_t nx = static_cast<std::size_t>(g.dims.x);
   const std::size_t nxy = nx * static_cast<std::size_t>(g.dims.y);
   const std::size_t y0 = static_cast<std::size_t>(t.y.i0) * nx, y1 = static_cast<std::size_t>(t.y.i1) * nx;
@@ -57,7 +58,6 @@ inline Out interpolate(const std::vector<T>& data, const GridSpec& g, const Taps
   const std::size_t x0 = static_cast<std::size_t>(t.x.i0), x1 = static_cast<std::size_t>(t.x.i1);
   const double fx = t.x.f, fy = t.y.f, fz = t.z.f;
   const double gx = 1.0 - fx, gy = 1.0 - fy, gz = 1.0 - fz;
-  auto at = [&](std::size_t i) { return Out(data[i]); };
   const Out c00 = at(x0 + y0 + z0) * gx + at(x1 + y0 + z0) * fx;
   const Out c10 = at(x0 + y1 + z0) * gx + at(x1 + y1 + z0) * fx;
   const Out c01 = at(x0 + y0 + z1) * gx + at(x1 + y0 + z1) * fx;
@@ -65,26 +65,19 @@ inline Out interpolate(const std::vector<T>& data, const GridSpec& g, const Taps
   return (c00 * gy + c10 * fy) * gz + (c01 * gy + c11 * fy) * fz;
 }
 
+// The trilinear interpolant of a field of one T a voxel (glm vectors).
+template <typename Out, typename T>
+inline Out interpolate(const std::vector<T>& data, const GridSpec& g, const Taps3& t) {
+  return blendTaps<Out>(g, t, [&](std::size_t i) { return Out(data[i]); });
+}
+
 // interpolate for S < 4 floats a voxel (the used slots' distances), the rest of the vec4 `rest`:
 // the same weights and the same order of sums per component, so the same values as the vec4's.
 template <int S>
 inline glm::dvec4 interpolateUsed(const std::vector<float>& data, float rest, const GridSpec& g, const Taps3& t) {
-  const std::size_t nx = static_cast<std::size_t>(g.dims.x);
-  const std::size_t nxy = nx * static_cast<std::size_t>(g.dims.y);
-  const std::size_t y0 = static_cast<std::size_t>(t.y.i0) * nx, y1 = static_cast<std::size_t>(t.y.i1) * nx;
-  const std::size_t z0 = static_cast<std::size_t>(t.z.i0) * nxy, z1 = static_cast<std::size_t>(t.z.i1) * nxy;
-  const std::size_t x0 = static_cast<std::size_t>(t.x.i0), x1 = static_cast<std::size_t>(t.x.i1);
-  const double fx = t.x.f, fy = t.y.f, fz = t.z.f;
-  const double gx = 1.0 - fx, gy = 1.0 - fy, gz = 1.0 - fz;
   glm::dvec4 out(static_cast<double>(rest));
-  for (int k = 0; k < S; ++k) {
-    auto at = [&](std::size_t i) { return static_cast<double>(data[i * S + static_cast<std::size_t>(k)]); };
-    const double c00 = at(x0 + y0 + z0) * gx + at(x1 + y0 + z0) * fx;
-    const double c10 = at(x0 + y1 + z0) * gx + at(x1 + y1 + z0) * fx;
-    const double c01 = at(x0 + y0 + z1) * gx + at(x1 + y0 + z1) * fx;
-    const double c11 = at(x0 + y1 + z1) * gx + at(x1 + y1 + z1) * fx;
-    out[k] = (c00 * gy + c10 * fy) * gz + (c01 * gy + c11 * fy) * fz;
-  }
+  for (int k = 0; k < S; ++k)
+    out[k] = blendTaps<double>(g, t, [&](std::size_t i) { return static_cast<double>(data[i * S + static_cast<std::size_t>(k)]); });
   return out;
 }
 

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "core/error.h"
+#include "core/interfaces.h"
 #include "lightsim/bake.h"
 #include "lightsim/test_scenes.h"
 
@@ -113,6 +114,35 @@ TEST(VolumeSampler, HandValuesOnALinearField) {
   EXPECT_NEAR(s.ior(g.bounds_min), 1.0, 1e-9);                        // the corner holds voxel 0
   EXPECT_FALSE(s.hasAbsorption());
   EXPECT_EQ(s.sigmaA(world(1, 1, 1)), glm::dvec3(0.0));
+}
+
+// The slot distances read from the used slots alone (one to three floats a voxel) are the
+// trilinear interpolant of the interfaces field as it is (all four channels), and a field whose
+// unused channels vary is read whole.
+TEST(VolumeSampler, SlotDistancesAreTheInterfacesFieldsInterpolant) {
+  const std::vector<std::vector<std::string>> scenes = {
+      {"procedural:sphere,r=0.3,ior=1.5"},
+      {"procedural:wine_glass,height=0.8"},
+      {"procedural:layered_cube,size=0.8,radius=0.1"}};
+  std::mt19937 rng(11);
+  for (const auto& specs : scenes) {
+    Volume v = test_scenes::sharpVolume(specs, 24);
+    const int slots = static_cast<int>(interfaceTable(v).slots.size());
+    for (int vary = 0; vary < 2; ++vary) {
+      if (vary && slots < 4) v.fields.at("interfaces").voxel(7)[3] += 0.5f;  // an unused channel that varies
+      const VolumeSampler sampler(v);
+      ASSERT_EQ(sampler.slotCount(), slots);
+      const GridSpec& g = v.grid;
+      std::uniform_real_distribution<double> u(0.0, 1.0);
+      for (int n = 0; n < 200; ++n) {
+        // Inside the grid and a little beyond it (clamp to edge).
+        const glm::dvec3 p = g.bounds_min + (glm::dvec3(u(rng), u(rng), u(rng)) * 1.1 - 0.05) * g.extent();
+        const glm::dvec4 got = sampler.distances(p);
+        const glm::dvec4 want = sampleTrilinear(v.fields.at("interfaces"), g, p);
+        for (int k = 0; k < 4; ++k) EXPECT_NEAR(got[k], want[k], 1e-9 * (1.0 + std::abs(want[k]))) << slots << " slots, k " << k;
+      }
+    }
+  }
 }
 
 TEST(VolumeSampler, RequiresIorAndGradient) {
