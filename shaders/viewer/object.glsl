@@ -482,7 +482,7 @@ void inScatter@(inout Ray r, March@ m, vec3 uvw, float hs) {
 // axis), so no surface lies within nearest/√3 (the field is clamped to ±4 voxels: steps up to
 // 2.3 voxels; SKIP_TO_SURFACES, the viewer's empty-space skipping). σa is taken at the step's
 // start, constant within a material. Where scattering must be sampled, it is the same but at most
-// a voxel when every material's ω̂ is a constant (MEDIUM_SCATTER) and the ray is in one that
+// two voxels when every material's ω̂ is a constant (MEDIUM_SCATTER) and the ray is in one that
 // scatters, else the fixed steps above.
 float stepLength@(March@ m, vec3 uvw, float grad2) {
   bool quiet = grad2 <= m.quiet2;
