@@ -481,7 +481,7 @@ void inScatter@(inout Ray r, March@ m, vec3 uvw, float hs) {
 // by at most one per unit length changes by at most √3 per unit length (|∂d/∂x_i| ≤ 1 on every
 // axis), so no surface lies within nearest/√3 (the field is clamped to ±4 voxels: steps up to
 // 2.3 voxels; SKIP_TO_SURFACES, the viewer's empty-space skipping). σa is taken at the step's
-// start, constant within a material. Where scattering must be sampled, it is the same but at most
+// middle, constant within a material. Where scattering must be sampled, it is the same but at most
 // two voxels when every material's ω̂ is a constant (MEDIUM_SCATTER) and the ray is in one that
 // scatters, else the fixed steps above.
 float stepLength@(March@ m, vec3 uvw, float grad2) {
