@@ -33,7 +33,8 @@ class CompactPass {
   // pyramidDefines: HistoPyramid::defines() of the pyramids it will read (their levels).
   CompactPass(const gl::ShaderLibrary& library, const gl::ShaderDefines& pyramidDefines,
               const std::string& volumeDefines);
-  // dt: Δt (with sharp interfaces the reach of a followed reflection, sharp.glsl reflectedPatch).
+  // dt: an ordinary step's time, Δt or a straight step's (StepUniforms::stepDt): with sharp
+  // interfaces the reach of a followed reflection, 4·dt + 2h (sharp.glsl reflectedPatch).
   void run(const PatchTextures& in, const StepTargets& targets, PatchTextures& out, std::size_t total,
            const gl::VolumeTextures& volume, const GridUniforms& grid, float dt = 0.0f) const;
 

@@ -19,12 +19,14 @@
 #include "lightsim/analysis_pass.h"
 #include "lightsim/atlas.h"
 #include "lightsim/compact_pass.h"
+#include "lightsim/cpu_simulator.h"
 #include "lightsim/deposit_pass.h"
 #include "lightsim/grid_uniforms.h"
 #include "lightsim/histo_pyramid.h"
 #include "lightsim/ledger_pass.h"
 #include "lightsim/list_set.h"
 #include "lightsim/patch_textures.h"
+#include "lightsim/quiet_texture.h"
 #include "lightsim/receiver.h"
 #include "lightsim/receiver_pass.h"
 #include "lightsim/step_uniforms.h"
@@ -73,13 +75,15 @@ struct GpuSimulator::Impl {
   GpuRunInfo info;
 
   // Programs, made on first use and kept across runs.
-  std::map<Integrator, std::unique_ptr<gpu::UpdatePass>> updates;
+  std::map<std::tuple<Integrator, bool, bool>, std::unique_ptr<gpu::UpdatePass>> updates;  // + flight, absorber map
   std::map<DepositMode, std::unique_ptr<gpu::DepositPass>> deposits;
   std::map<std::tuple<DepositMode, bool, bool>, std::unique_ptr<gpu::AnalysisPass>> analyses;
   std::map<int, std::unique_ptr<gpu::CompactPass>> compacts;  // by pyramid levels
   std::unique_ptr<gpu::LedgerPass> ledger;
   std::unique_ptr<gpu::ReceiverPass> receiverPass;
   std::unique_ptr<gpu::TrackDepositPass> trackPass;
+  // The quiet maps' tables (free flight; straight steps in absorbing volumes), made on first use.
+  gpu::QuietTexture quietTable, absorberTable;
 
   Impl(const Volume& v, const GpuSimulatorOptions& o)
       : config(o),
@@ -142,10 +146,26 @@ struct GpuSimulator::Impl {
     return gl::VolumeTextures(simulationFields(v), vo);
   }
 
-  gpu::UpdatePass& update(Integrator i) {
-    auto& p = updates[i];
-    if (!p) p = std::make_unique<gpu::UpdatePass>(library, i, volumeDefines);
+  gpu::UpdatePass& update(Integrator i, const gpu::UpdateMaps& maps) {
+    const bool flight = maps.quiet != nullptr, absorbers = maps.absorbers != nullptr;
+    auto& p = updates[{i, flight, absorbers}];
+    if (!p) p = std::make_unique<gpu::UpdatePass>(library, i, volumeDefines, flight, absorbers);
     return *p;
+  }
+  // The maps a run of `options` reads: free flight where the run has no volume deposits (the track
+  // deposit pass bounds a step's extent), straight steps where straightSteps allows them (an
+  // absorbing volume's only where its absorber map finds σa = 0).
+  gpu::UpdateMaps updateMaps(const SimulationOptions& options, bool track) {
+    gpu::UpdateMaps maps;
+    if (options.free_flight && track && !options.volume_deposits) {
+      if (!quietTable) quietTable = gpu::QuietTexture(sampler.quietMap());
+      if (quietTable) maps.quiet = &quietTable;
+    }
+    if (straightSteps(sampler, options) && sampler.hasAbsorption()) {
+      if (!absorberTable) absorberTable = gpu::QuietTexture(sampler.absorberMap());
+      if (absorberTable) maps.absorbers = &absorberTable;
+    }
+    return maps;
   }
   gpu::DepositPass& deposit(DepositMode m) {
     auto& p = deposits[m];
@@ -304,6 +324,12 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   ledger.reset();
 
   gpu::StepUniforms step = gpu::StepUniforms::from(localGrid(grid, origin), options, fluxRef);
+  const gpu::UpdateMaps maps = updateMaps(options, track);
+  info.volume_bytes = volume.bytes() + quietTable.bytes() + absorberTable.bytes();
+  if (straightSteps(sampler, options) && (!sampler.hasAbsorption() || maps.absorbers)) {
+    step.stepDt = static_cast<float>(options.straight_step_voxels * voxelEdge(grid));
+    step.straightReach = static_cast<float>(step.stepDt / std::min(1.0, sampler.minIor()));
+  }
   if (options.receiver) {
     step.receiverPoint = glm::vec3(receiver.point - origin);
     step.receiverNormal = glm::vec3(receiver.normal);
@@ -314,7 +340,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   for (const Patch& p : initial) eRef = std::max(eRef, luminance(p.irradiance()));
   const float energyRef = static_cast<float>(std::max(eRef * 1e-3, 1e-30));
 
-  const gpu::UpdatePass& updatePass = update(options.integrator);
+  const gpu::UpdatePass& updatePass = update(options.integrator, maps);
   const gpu::DepositPass& depositPass = deposit(options.deposit);
   // Track deposits: the bound on a patch-step's extent (in voxels, any axis) that sizes the pass's
   // points. Patches are split at split_voxels and kept up to kMaxUnsplitEdge split lengths, a
@@ -361,7 +387,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     gpu::ListSet& L = *lists;
 
     timer.start("update");
-    updatePass.run(L.a, L.b, count, volume, gridUniforms, step);
+    updatePass.run(L.a, L.b, count, volume, gridUniforms, step, maps);
     timer.start("analysis");
     analysisPass.run(L.b, L.a, count, L.targets, volume, gridUniforms, step);
     timer.start("deposit");
@@ -409,13 +435,13 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
       timer.start("grow");
       auto grown = std::make_unique<gpu::ListSet>(side, library);
       timer.start("compact");
-      compact(L.targets.pyramid).run(L.b, L.targets, grown->a, total, volume, gridUniforms, step.dt);
+      compact(L.targets.pyramid).run(L.b, L.targets, grown->a, total, volume, gridUniforms, step.stepDt);
       timer.stop();
       lists = std::move(grown);
       info.peak_patch_side = std::max(info.peak_patch_side, lists->side());
     } else if (total > 0) {
       timer.start("compact");
-      compact(L.targets.pyramid).run(L.b, L.targets, L.a, total, volume, gridUniforms, step.dt);
+      compact(L.targets.pyramid).run(L.b, L.targets, L.a, total, volume, gridUniforms, step.stepDt);
       timer.stop();
     }
     count = static_cast<std::size_t>(total);

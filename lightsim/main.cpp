@@ -71,12 +71,13 @@ int run(int argc, char** argv) {
       ->check(CLI::IsMember({"track", "point"}));
   std::string free_flight = "on";
   app.add_option("--free-flight", free_flight,
-                 "on (default: the CPU twin crosses quiet space, where n is constant and no interface lies, in one "
-                 "straight step; the same bake in fewer steps) or off (steps of --step everywhere, as the GPU path)")
+                 "on (default: a patch crosses quiet space, where n is constant and no interface lies, in one "
+                 "straight step; the same bake in fewer steps; the GPU path only without volume deposits and where "
+                 "nothing absorbs) or off (steps of --step everywhere)")
       ->check(CLI::IsMember({"on", "off"}));
   options.straight_step_voxels = 2.0;
   app.add_option("--straight-step", options.straight_step_voxels,
-                 "VOXELS: the CPU twin's step where every ray is straight between sharp interfaces and crosses "
+                 "VOXELS: the step where every ray is straight between sharp interfaces and crosses "
                  "them exactly (materials of constant n, no volume deposits, nothing absorbing within reach; "
                  "default 2, 0: off, steps of --step)")
       ->check(CLI::Range(0.0, 64.0));

@@ -48,6 +48,9 @@ class QuietMap {
   glm::ivec3 bricks() const { return bricks_; }
   int brickVoxels() const { return brick_; }  // voxels per brick edge
   std::size_t noisyBricks() const { return noisy_; }
+  // The summed-area table, (bricks + 1)³ entries, x fastest: entry (i, j, k) counts the noisy
+  // bricks with indices below (i, j, k) (the GPU's copy: quiet_texture.h).
+  const std::vector<std::uint32_t>& table() const { return sat_; }
 
  private:
   GridSpec grid_;

@@ -78,14 +78,16 @@ struct SimulationOptions {
   int max_steps = 0;              // 0: 4 × the grid diagonal in steps
   // Free flight (ALGORITHM.md "Free flight"): a patch whose swept box is quiet (quiet_map.h) takes
   // one straight step across it instead of steps of Δt. Needs the track kernel (accumulate);
-  // ignored otherwise. The CPU twin only: the GPU path steps by Δt everywhere. `lightsim` turns it
-  // on (--free-flight); off here so that the twin and the GPU path compare step for step.
+  // ignored otherwise. The GPU path flies only without volume deposits and where σa = 0
+  // (shaders/lightsim/flight.glsl). `lightsim` turns it on (--free-flight); off here so that the
+  // twin and the GPU path compare step for step.
   bool free_flight = false;
   // Straight steps (ALGORITHM.md "Straight steps"): in a sharp volume whose materials all have a
   // constant n, with no volume deposits, every corner's ray is straight between interfaces and
   // crosses them exactly, so an ordinary step may be this many voxels instead of step_voxels where
-  // nothing absorbs within its reach; only where patches split and tear depends on it. 0 (or ≤ step_voxels): off. The
-  // CPU twin only; `lightsim` sets 2 (--straight-step), off here so that the back ends compare.
+  // nothing absorbs within its reach; only where patches split and tear depends on it. 0 (or ≤
+  // step_voxels): off. Both back ends; `lightsim` sets 2 (--straight-step), off here so that the
+  // back ends compare step for step.
   double straight_step_voxels = 0.0;
   // Volume deposits (ALGORITHM.md step 4): the bake's `irradiance` and `light_dir` fields. Off, a
   // bake makes only the receiver's map (and the statistics): the deposits, most of a glass

@@ -8,6 +8,7 @@ namespace eik::gpu {
 StepUniforms StepUniforms::from(const GridSpec& grid, const SimulationOptions& options, double fluxRef) {
   StepUniforms step;
   step.dt = static_cast<float>(timeStep(grid, options));
+  step.stepDt = step.dt;
   step.boundaryOn = static_cast<float>(options.boundary_on);
   step.boundaryOff = static_cast<float>(options.boundary_off);
   step.fluxKill = static_cast<float>(options.flux_threshold * fluxRef);
@@ -19,6 +20,7 @@ StepUniforms StepUniforms::from(const GridSpec& grid, const SimulationOptions& o
   propagationBox(grid, options, lo, hi);
   step.boxMin = glm::vec3(lo);
   step.boxMax = glm::vec3(hi);
+  step.flightCap = static_cast<float>(glm::length(hi - lo));
   step.bounces = options.bounces;
   return step;
 }

@@ -13,6 +13,11 @@ namespace eik::gpu {
 
 struct StepUniforms {
   float dt = 0.0f;                              // Δt
+  // An ordinary step's time with sharp interfaces: a straight step's (straight_step_voxels·h) where
+  // they apply to the run (straightSteps, cpu_simulator.h), else Δt; and how far it reaches from
+  // the corners (its time / min(1, min n)), the box the absorber map must find σa = 0 in.
+  float stepDt = 0.0f, straightReach = 0.0f;
+  float flightCap = 0.0f;                       // free flight: the propagation box's diagonal
   float boundaryOn = 0.0f, boundaryOff = 0.0f;  // g_on, g_off
   float fluxKill = 0.0f;                        // flux_threshold · Φ_ref
   float splitLength = 0.0f;                     // split_voxels · h · (1 + margin)
@@ -27,6 +32,7 @@ struct StepUniforms {
   // The uniforms of a run of `options` on `grid`, whose largest initial patch flux is Φ_ref =
   // fluxRef (initialPatches): Δt = timeStep, the split length splitThreshold, the box
   // propagationBox (wavefront.h), in the frame of `grid` (GpuSimulator passes the grid-local one).
+  // stepDt is Δt here: the simulator sets a straight step's where its volume allows them.
   static StepUniforms from(const GridSpec& grid, const SimulationOptions& options, double fluxRef);
 };
 

@@ -1,6 +1,8 @@
 // The update pass, ALGORITHM.md steps 1–3 (see update_pass.h).
 #include "lightsim/update_pass.h"
 
+#include <stdexcept>
+
 #include "gl/debug.h"
 #include "gl/scoped_state.h"
 
@@ -17,22 +19,40 @@ const char* integratorDefine(Integrator integrator) {
   return "INTEGRATOR_EULER";
 }
 
+gl::ShaderDefines defines(Integrator integrator, bool freeFlight, bool absorberMap) {
+  gl::ShaderDefines d{{integratorDefine(integrator), "1"}};
+  if (freeFlight) d.push_back({"FREE_FLIGHT", "1"});
+  if (absorberMap) d.push_back({"ABSORBER_MAP", "1"});
+  return d;
+}
+
 }  // namespace
 
-UpdatePass::UpdatePass(const gl::ShaderLibrary& library, Integrator integrator, const std::string& volumeDefines)
-    : program_(library.program("common/fullscreen.vert", "lightsim/update.frag", {{integratorDefine(integrator), "1"}},
-                               volumeDefines)) {}
+UpdatePass::UpdatePass(const gl::ShaderLibrary& library, Integrator integrator, const std::string& volumeDefines,
+                       bool freeFlight, bool absorberMap)
+    : program_(library.program("common/fullscreen.vert", "lightsim/update.frag",
+                               defines(integrator, freeFlight, absorberMap), volumeDefines)),
+      freeFlight_(freeFlight),
+      absorberMap_(absorberMap) {}
 
 void UpdatePass::run(const PatchTextures& in, PatchTextures& out, std::size_t count, const gl::VolumeTextures& volume,
-                     const GridUniforms& grid, const StepUniforms& step) const {
+                     const GridUniforms& grid, const StepUniforms& step, const UpdateMaps& maps) const {
   gl::ScopedPassBindings unbind;
   out.framebuffer().bind();
   viewportLiveBox(count);
   program_.use();
-  volume.bind(program_, in.bind(program_, "uPatch", 0));
+  int unit = volume.bind(program_, in.bind(program_, "uPatch", 0));
+  if (freeFlight_ != (maps.quiet && *maps.quiet) || absorberMap_ != (maps.absorbers && *maps.absorbers))
+    throw std::logic_error("UpdatePass::run: the quiet maps differ from the ones the pass was made for");
+  if (freeFlight_) maps.quiet->bind(program_, "uQuietSat", unit++);
+  if (absorberMap_) maps.absorbers->bind(program_, "uAbsorberSat", unit++);
   grid.set(program_);
   program_.set("uCount", static_cast<int>(count));
   program_.set("uDt", step.dt);
+  program_.set("uStepDt", step.stepDt);
+  program_.set("uStraightReach", step.straightReach);
+  program_.set("uFlightCap", step.flightCap);
+  program_.set("uKeepAtMaxDepth", !step.killAtMaxDepth);
   program_.set("uBoundaryOn", step.boundaryOn);
   program_.set("uBoundaryOff", step.boundaryOff);
   program_.set("uSplitLength", step.splitLength);  // sharp interfaces: tears

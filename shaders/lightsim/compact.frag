@@ -20,7 +20,7 @@
 #ifdef SHARP_INTERFACES
 #include "lightsim/fresnel.glsl"
 #include "lightsim/sharp.glsl"
-uniform float uDt;  // Δt (the reach of reflectedPatch: 4 Δt + 2 h)
+uniform float uDt;  // an ordinary step's time, Δt or a straight step's (the reach of reflectedPatch: 4 Δt + 2 h)
 #endif
 
 uniform sampler2D uPatch[8];   // the updated list (source)

@@ -14,23 +14,27 @@
 // kTearFactor split lengths, or a first touch whose other corners will not meet the same surface
 // (willTear) — is undone and the event tells the analysis to split the patch as it was
 // (SHARP_EVENT_SPLIT_U/V), or, at the depth limit, that it dies (SHARP_EVENT_TORN).
+// FREE_FLIGHT / ABSORBER_MAP (flight.glsl): a patch in quiet space crosses it in one straight step;
+// with sharp interfaces an ordinary step is a straight step (uStepDt) where they apply.
 #include "common/volume.glsl"
 #include "lightsim/grid.glsl"
 #include "lightsim/patch.glsl"
 #include "lightsim/fresnel.glsl"
-#ifdef SHARP_INTERFACES
-#include "lightsim/sharp.glsl"
-uniform float uSplitLength;  // split_voxels · h · (1 + margin)
-uniform float uMaxDepth;     // max_depth
-uniform bool uAxisSplit;     // SplitRule::Axis
-const float kTearFactor = 2.0;  // cpu_simulator.cpp
-#endif
 
 uniform sampler2D uPatch[8];
 uniform int uCount;            // live patches
 uniform float uDt;             // Δt = step_voxels·h
 uniform float uBoundaryOn;     // g_on  (|∇n|·h entering a layer)
 uniform float uBoundaryOff;    // g_off (|∇n|·h leaving it)
+uniform float uSplitLength;    // split_voxels · h · (1 + margin): tears, flights
+uniform float uMaxDepth;       // max_depth
+
+#ifdef SHARP_INTERFACES
+#include "lightsim/sharp.glsl"
+uniform bool uAxisSplit;     // SplitRule::Axis
+const float kTearFactor = 2.0;  // cpu_simulator.cpp
+#endif
+#include "lightsim/flight.glsl"
 
 layout(location = 0) out vec4 oP0;
 layout(location = 1) out vec4 oP1;
@@ -117,16 +121,30 @@ void main() {
   Patch before = p;
   vec3 mOld = patchMidpoint(p);
 
-  // Step 1 with sharp interfaces.
+  // Step 1 with sharp interfaces: a free flight across quiet space (straight rays, no interface in
+  // the swept box), or an ordinary step of Δt (a straight step where they apply) in which every
+  // corner crosses the interfaces on its way.
   float transmittance = 1.0;
   int metMask = 0, transmittedMask = 0, blocked = 0, reflections = 0;
-  for (int c = 0; c < 4; ++c) {
-    CornerCrossings cc = advanceCornerSharp(p.x[c], p.w[c], p.medium[c], uDt);
-    if (cc.transmitted > 0 || cc.reflected > 0 || cc.blocked) metMask |= 1 << c;
-    reflections += cc.reflected;
-    blocked += cc.blocked ? 1 : 0;
-    if (cc.transmitted > 0) transmittedMask |= 1 << c;
-    transmittance *= pow(cc.transmittance, 0.25);
+  float flight = 0.0;
+#ifdef FREE_FLIGHT
+  flight = freeFlightTime(p);
+#endif
+  if (flight > 0.0) {
+    for (int c = 0; c < 4; ++c) {
+      float n = materialOptics(p.medium[c], p.x[c]).x;
+      p.x[c] += flight * p.w[c] / (n * n);  // Eq. 6.1, exact for a straight ray
+    }
+  } else {
+    float dt = sharpStepTime(p);
+    for (int c = 0; c < 4; ++c) {
+      CornerCrossings cc = advanceCornerSharp(p.x[c], p.w[c], p.medium[c], dt);
+      if (cc.transmitted > 0 || cc.reflected > 0 || cc.blocked) metMask |= 1 << c;
+      reflections += cc.reflected;
+      blocked += cc.blocked ? 1 : 0;
+      if (cc.transmitted > 0) transmittedMask |= 1 << c;
+      transmittance *= pow(cc.transmittance, 0.25);
+    }
   }
   p.reflections += reflections;
   if (metMask != 0 && oneMedium(before)) {
@@ -171,8 +189,19 @@ void main() {
   vec3 mOld = patchMidpoint(p);
   vec3 dOld = patchDirection(p);
 
-  // Step 1: Eq. 6.1/6.2 (or RK2/RK4) per corner.
-  for (int c = 0; c < 4; ++c) stepCorner(p.x[c], p.w[c]);
+  // Step 1: a free flight across quiet space, or Eq. 6.1/6.2 (or RK2/RK4) per corner.
+  float flight = 0.0;
+#ifdef FREE_FLIGHT
+  flight = freeFlightTime(p);
+#endif
+  if (flight > 0.0) {
+    for (int c = 0; c < 4; ++c) {
+      float n = sampleIor(p.x[c]);
+      p.x[c] += flight * p.w[c] / (n * n);  // Eq. 6.1, exact for a straight ray
+    }
+  } else {
+    for (int c = 0; c < 4; ++c) stepCorner(p.x[c], p.w[c]);
+  }
 
   // Step 2: absorption at the old midpoint.
   p.flux *= absorptionFactor(mOld, uDt);
