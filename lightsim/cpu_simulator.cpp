@@ -286,7 +286,7 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
   const SimulationOptions& options = *ctx.options;
   const GridSpec& grid = sampler.grid();
   const double h = sampler.h();
-  const double threshold = splitThreshold(grid, options);
+  const double threshold = splitThreshold(grid, options) * (patch.bounce > 0 ? kReflectedSplitFactor : 1.0);
   const bool sharp = sampler.sharp();
   const bool track = options.deposit == DepositMode::Accumulate && options.deposit_kernel == DepositKernel::Track;
   PatchStepResult result;

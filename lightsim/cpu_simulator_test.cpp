@@ -620,6 +620,38 @@ TEST(CpuSimulator, APatchPastSixteenTotalInternalReflectionsIsTrappedNotKilled) 
   }
 }
 
+// A reflected wavefront (bounce ≥ 1) splits at kReflectedSplitFactor split lengths, the light that
+// entered at one (wavefront.h): a patch in the middle of a glass block, going down, with edges of
+// 2 and of 5 split lengths. (The GPU path's rule, fate.glsl, is checked by its patch-steps against
+// the twin's in ExactOpticsSphere.TheGpuPathFliesAndTakesStraightStepsAsTheTwinDoes.)
+TEST(CpuSimulator, AReflectedWavefrontSplitsAtFourSplitLengths) {
+  const Volume v = sharpVolume("procedural:box,size=0.8:0.8:0.8,center=0:0:0,ior=1.5", 24, cube(0.5));
+  const VolumeSampler sampler(v);
+  SimulationOptions options;
+  const StepContext ctx = makeStepContext(sampler, options, 1.0);
+  const double split = splitThreshold(sampler.grid(), options);
+  for (const double edges : {2.0, 5.0}) {
+    for (const int bounce : {0, 1}) {
+      Patch patch;
+      const double e = 0.5 * edges * split;
+      const glm::dvec3 corners[4] = {{-e, 0.0, -e}, {e, 0.0, -e}, {e, 0.0, e}, {-e, 0.0, e}};
+      for (int c = 0; c < 4; ++c) {
+        patch.x[c] = corners[c];
+        patch.medium[c] = sampler.materialAt(patch.x[c]);
+        patch.w[c] = sampler.materialOptics(patch.medium[c], patch.x[c]).x * glm::dvec3(0.0, -1.0, 0.0);
+      }
+      ASSERT_EQ(patch.medium[0], 0);  // inside the glass
+      patch.flux = glm::dvec3(1e-3);
+      patch.area0 = patch.area();
+      patch.bounce = bounce;
+      PatchSamples samples = samplePatch(patch, sampler);
+      const PatchStepResult r = stepPatch(patch, samples, ctx);
+      const bool splits = bounce == 0 || edges > kReflectedSplitFactor;
+      EXPECT_EQ(r.fate, splits ? PatchFate::Split : PatchFate::Keep) << "edges " << edges << ", bounce " << bounce;
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Timings for the report (not a test): --gtest_also_run_disabled_tests
 // --gtest_filter='*CpuBench*'. BENCH_RES (default 64) sets the sphere's resolution (voxels across

@@ -271,8 +271,8 @@ TEST(ExactOpticsSphere, TheGpuPathFliesAndTakesStraightStepsAsTheTwinDoes) {
   const SphereBake gpu = bakeSphereOnFloor(48, Stepping::Straight, Backend::Gl);
   EXPECT_EQ(gpu.stats.backend, "gl");
   // Float against double corners: where a patch splits or a flight ends moves by rounding, so the
-  // two bakes are not the same patch for patch. Measured at 64³: 7.3e-4 relative L2, 565 978
-  // against 565 991 patch-steps; 2 % more patch-steps would be a flight or straight step refused.
+  // two bakes are not the same patch for patch. Measured at 48³: 8.0e-4 relative L2, 252 548
+  // against 253 103 patch-steps; 2 % more patch-steps would be a flight or straight step refused.
   const double map = relativeL2(gpu.map.irradiance, cpu.map.irradiance);
   std::printf("GPU path against the twin, 48³: map %.2e relative L2; %llu against %llu patch-steps\n", map,
               static_cast<unsigned long long>(gpu.stats.total_patches),
@@ -282,7 +282,8 @@ TEST(ExactOpticsSphere, TheGpuPathFliesAndTakesStraightStepsAsTheTwinDoes) {
     EXPECT_NEAR(gpu.rings.irradiance[k] / cpu.rings.irradiance[k], 1.0, 0.01) << "ring " << k;
   EXPECT_NEAR(static_cast<double>(gpu.stats.total_patches), static_cast<double>(cpu.stats.total_patches),
               0.02 * static_cast<double>(cpu.stats.total_patches));
-  EXPECT_EQ(gpu.stats.steps, cpu.stats.steps);
+  // The last patch alive may die a step earlier or later (measured: 43 against 42 steps).
+  EXPECT_NEAR(gpu.stats.steps, cpu.stats.steps, 2);
   expectConvergesToExactOptics(bakeSphereOnFloor(32, Stepping::Straight, Backend::Gl), gpu);
 }
 

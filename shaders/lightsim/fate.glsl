@@ -25,18 +25,19 @@ int patchFate(Patch p, bool splittable) {
   if (!(dot(patchAreaVector(p), d) > 0.0)) return FATE_FOLDED;
 #endif
   // split (wavefront.h splitAxes): u edges x0x1, x3x2; v edges x1x2, x0x3
+  float splitLength = splitLengthOf(p, uSplitLength);
   float uEdge = max(distance(p.x[0], p.x[1]), distance(p.x[3], p.x[2]));
   float vEdge = max(distance(p.x[1], p.x[2]), distance(p.x[0], p.x[3]));
   bool splitU, splitV;
   if (uAxisSplit) {
-    splitU = uEdge > uSplitLength;
-    splitV = vEdge > uSplitLength;
+    splitU = uEdge > splitLength;
+    splitV = vEdge > splitLength;
   } else {
-    splitU = splitV = max(uEdge, vEdge) > uSplitLength;  // Quad: the longest side decides
+    splitU = splitV = max(uEdge, vEdge) > splitLength;  // Quad: the longest side decides
   }
   if (!(splitU || splitV)) return FATE_KEEP;
   // At max_depth: kept unsplit (DepthLimit::Keep) while the longest edge is at most
   // kMaxUnsplitEdge (4) split lengths (wavefront.h), else killed.
-  if (!splittable || p.depth >= uMaxDepth) return uKillAtMaxDepth || max(uEdge, vEdge) > 4.0 * uSplitLength ? FATE_DEPTH : FATE_KEEP;
+  if (!splittable || p.depth >= uMaxDepth) return uKillAtMaxDepth || max(uEdge, vEdge) > 4.0 * splitLength ? FATE_DEPTH : FATE_KEEP;
   return splitU && splitV ? FATE_SPLIT : splitU ? FATE_SPLIT_U : FATE_SPLIT_V;
 }

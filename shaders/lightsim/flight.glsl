@@ -79,6 +79,7 @@ float freeFlightTime(Patch p) {
     v[c] = p.w[c] / (s.x * s.x);  // dx/dt, Eq. 6.1
   }
   bool kept = uKeepAtMaxDepth && p.depth >= uMaxDepth;
+  float splitLength = splitLengthOf(p, uSplitLength);
   float tMax = 3.4e38;
   for (int c = 0; c < 4; ++c) {
     tMax = min(tMax, uFlightCap * n[c]);  // a path of length ℓ takes time ℓ·n
@@ -89,7 +90,7 @@ float freeFlightTime(Patch p) {
     float a = dot(dv, dv);
     if (!(a > 0.0)) continue;
     float edge2 = dot(e0, e0);
-    float limit = kept ? 4.0 * uSplitLength : max(uSplitLength, sqrt(edge2));  // kMaxUnsplitEdge
+    float limit = kept ? 4.0 * splitLength : max(splitLength, sqrt(edge2));  // kMaxUnsplitEdge
     float b = dot(e0, dv);
     float disc = max(0.0, b * b - a * (edge2 - limit * limit));
     tMax = min(tMax, (-b + sqrt(disc)) / a);

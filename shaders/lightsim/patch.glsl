@@ -65,6 +65,17 @@ vec4 packSharpMeta(Patch p) {
 #endif
 
 
+// The split length of patch p for the run's split length `base`: reflected wavefronts (bounce ≥ 1)
+// split at kReflectedSplitFactor times it (wavefront.h).
+const float kReflectedSplitFactor = 4.0;
+float splitLengthOf(Patch p, float base) {
+#ifdef SHARP_INTERFACES
+  return p.bounce > 0 ? kReflectedSplitFactor * base : base;
+#else
+  return base;
+#endif
+}
+
 // Morton (Z-order) index ↔ texel: x from the even bits, y from the odd bits (patch_textures.h).
 int mortonCompact1By1(int v) {
   v &= 0x55555555;

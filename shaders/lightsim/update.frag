@@ -148,7 +148,8 @@ void main() {
   }
   p.reflections += reflections;
   if (metMask != 0 && oneMedium(before)) {
-    bool stretched = splitAxesOf(p, kTearFactor * uSplitLength) != 0;
+    float splitLength = splitLengthOf(before, uSplitLength);
+    bool stretched = splitAxesOf(p, kTearFactor * splitLength) != 0;
     bool firstTouch = metMask != 15;
     bool tears = stretched || (firstTouch && willTear(p, metMask, 4.0 * max(longestEdge(p), uVoxelEdge)));
     if (tears && p.depth >= uMaxDepth) {
@@ -157,7 +158,7 @@ void main() {
       return;
     }
     if (tears) {
-      int axes = splitAxesOf(p, uSplitLength);
+      int axes = splitAxesOf(p, splitLength);
       if (axes == 0) axes = splitAxesOf(before, 0.0);  // a tear ahead: halve it
       before.event = axes;
       writePatch(before);
