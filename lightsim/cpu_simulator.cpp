@@ -212,9 +212,10 @@ bool willTear(const Patch& patch, const SharpUpdate& u, const VolumeSampler& sam
 
 // Free flight (ALGORITHM.md "Free flight"): the time of one straight step for the whole patch,
 // or 0 when it takes an ordinary step of Δt. Every corner moves on its straight ray
-// x_c + t·w_c/n_c², so the swept patch lies in the box of its corners at 0 and t (a bilinear patch
-// of linearly moving corners stays in their convex hull); the step is taken only where that box is
-// quiet. Its length: doubled from 2Δt while the box stays quiet, then refined by bisection, and
+// x_c + t·w_c/n_c², so the patch swept from t0 to t1 lies in the box of its corners at t0 and t1
+// (a bilinear patch of linearly moving corners stays in their convex hull); the step is taken only
+// where the boxes of its pieces are quiet. Its length: doubled from 2Δt while the path stays
+// quiet, then refined by bisection, and
 // bounded so that no edge grows past the split length (or past its length now, if longer) and by
 // ctx.flight_cap.
 double freeFlightTime(const Patch& patch, const PatchSamples& samples, const StepContext& ctx, double threshold) {
@@ -251,19 +252,24 @@ double freeFlightTime(const Patch& patch, const PatchSamples& samples, const Ste
   }
   const double dt = ctx.dt;
   if (!(t_max >= 2.0 * dt)) return 0.0;
-  auto quiet = [&](double t) {
+  // Whether the patch swept from time t0 to t1 is quiet: it lies in the box of its corners at t0
+  // and t1. The flight's path is covered piece by piece, each piece's box checked once: the
+  // doubling pieces [2^k·2Δt, 2^(k+1)·2Δt] and the bisection's [good, mid] hug a path that passes
+  // a curved surface, where one box from 0 to t would take the surface in.
+  auto quietBetween = [&](double t0, double t1) {
     glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
     for (int c = 0; c < 4; ++c) {
-      const glm::dvec3 end = patch.x[c] + t * v[static_cast<std::size_t>(c)];
-      lo = glm::min(lo, glm::min(patch.x[c], end));
-      hi = glm::max(hi, glm::max(patch.x[c], end));
+      const glm::dvec3 start = patch.x[c] + t0 * v[static_cast<std::size_t>(c)];
+      const glm::dvec3 end = patch.x[c] + t1 * v[static_cast<std::size_t>(c)];
+      lo = glm::min(lo, glm::min(start, end));
+      hi = glm::max(hi, glm::max(start, end));
     }
     return ctx.quiet->quiet(lo, hi);
   };
   double good = 0.0, bad = 0.0;
   for (double t = 2.0 * dt;; t *= 2.0) {
     const double tt = std::min(t, t_max);
-    if (!quiet(tt)) {
+    if (!quietBetween(good, tt)) {
       bad = tt;
       break;
     }
@@ -274,7 +280,7 @@ double freeFlightTime(const Patch& patch, const PatchSamples& samples, const Ste
   if (bad > 0.0)
     for (int i = 0; i < 3; ++i) {
       const double mid = 0.5 * (good + bad);
-      (quiet(mid) ? good : bad) = mid;
+      (quietBetween(good, mid) ? good : bad) = mid;
     }
   return good;
 }

@@ -43,21 +43,22 @@ bool boxQuiet(usampler3D sat, vec3 lo, vec3 hi) {
 #endif
 
 #ifdef FREE_FLIGHT
-// The box of the corners at times 0 and t, each on its straight ray x_c + t·v_c.
-bool flightQuiet(Patch p, vec3 v[4], float t) {
+// Whether the patch swept from time t0 to t1 is quiet: it lies in the box of its corners at t0
+// and t1, each on its straight ray x_c + t·v_c.
+bool flightQuiet(Patch p, vec3 v[4], float t0, float t1) {
   vec3 lo = vec3(3.4e38), hi = vec3(-3.4e38);
   for (int c = 0; c < 4; ++c) {
-    vec3 end = p.x[c] + t * v[c];
-    lo = min(lo, min(p.x[c], end));
-    hi = max(hi, max(p.x[c], end));
+    vec3 start = p.x[c] + t0 * v[c], end = p.x[c] + t1 * v[c];
+    lo = min(lo, min(start, end));
+    hi = max(hi, max(start, end));
   }
   return boxQuiet(uQuietSat, lo, hi);
 }
 
 // freeFlightTime (cpu_simulator.cpp): the time of one straight step for the whole patch, or 0 for
 // an ordinary step. Every corner moves on its straight ray, so the swept patch lies in the box of
-// its corners at 0 and t; t is doubled from 2Δt while that box is quiet, then refined by three
-// bisections, bounded so that no edge grows past the split length (or its length now, if longer;
+// its corners at 0 and t, checked piece by piece ([good, t] of the doubling and of the bisection);
+// t is doubled from 2Δt while the path is quiet, then refined by three bisections, bounded so that no edge grows past the split length (or its length now, if longer;
 // at the depth limit, as far as a kept patch goes) and by uFlightCap.
 float freeFlightTime(Patch p) {
 #ifdef SHARP_INTERFACES
@@ -99,7 +100,7 @@ float freeFlightTime(Patch p) {
   float good = 0.0, bad = 0.0;
   for (float t = 2.0 * uDt;; t *= 2.0) {
     float tt = min(t, tMax);
-    if (!flightQuiet(p, v, tt)) {
+    if (!flightQuiet(p, v, good, tt)) {
       bad = tt;
       break;
     }
@@ -110,7 +111,7 @@ float freeFlightTime(Patch p) {
   if (bad > 0.0)
     for (int i = 0; i < 3; ++i) {
       float mid = 0.5 * (good + bad);
-      if (flightQuiet(p, v, mid)) good = mid;
+      if (flightQuiet(p, v, good, mid)) good = mid;
       else bad = mid;
     }
   return good;
