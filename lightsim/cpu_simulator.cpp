@@ -245,7 +245,8 @@ double freeFlightTime(const Patch& patch, const PatchSamples& samples, const Ste
     const double a = glm::dot(dv, dv);
     if (!(a > 0.0)) continue;
     const double edge2 = glm::dot(e0, e0);
-    const double limit = kept ? kMaxUnsplitEdge * threshold : std::max(threshold, std::sqrt(edge2));
+    const double limit = kept ? kMaxUnsplitEdge * splitThreshold(ctx.sampler->grid(), *ctx.options)
+                              : std::max(threshold, std::sqrt(edge2));
     const double b = glm::dot(e0, dv);
     const double disc = std::max(0.0, b * b - a * (edge2 - limit * limit));
     t_max = std::min(t_max, (-b + std::sqrt(disc)) / a);
@@ -467,7 +468,9 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
     // With sharp interfaces a patch whose corners are in different materials (part way through an
     // interface) is not split: its new corners would mix the two sides' rays.
     const bool splittable = !sharp || (oneMedium(patch) && crossing.blocked == 0);
-    const bool keep = options.at_max_depth == DepthLimit::Keep && patch.longestEdge() <= kMaxUnsplitEdge * threshold;
+    // Kept within kMaxUnsplitEdge of the run's split length, a reflected wavefront's too.
+    const bool keep = options.at_max_depth == DepthLimit::Keep &&
+                      patch.longestEdge() <= kMaxUnsplitEdge * splitThreshold(grid, options);
     result.fate = splittable && patch.depth < options.max_depth ? PatchFate::Split
                   : keep                                        ? PatchFate::Keep
                                                                 : PatchFate::KilledDepth;

@@ -38,6 +38,6 @@ int patchFate(Patch p, bool splittable) {
   if (!(splitU || splitV)) return FATE_KEEP;
   // At max_depth: kept unsplit (DepthLimit::Keep) while the longest edge is at most
   // kMaxUnsplitEdge (4) split lengths (wavefront.h), else killed.
-  if (!splittable || p.depth >= uMaxDepth) return uKillAtMaxDepth || max(uEdge, vEdge) > 4.0 * splitLength ? FATE_DEPTH : FATE_KEEP;
+  if (!splittable || p.depth >= uMaxDepth) return uKillAtMaxDepth || max(uEdge, vEdge) > 4.0 * uSplitLength ? FATE_DEPTH : FATE_KEEP;
   return splitU && splitV ? FATE_SPLIT : splitU ? FATE_SPLIT_U : FATE_SPLIT_V;
 }

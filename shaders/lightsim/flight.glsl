@@ -91,7 +91,7 @@ float freeFlightTime(Patch p) {
     float a = dot(dv, dv);
     if (!(a > 0.0)) continue;
     float edge2 = dot(e0, e0);
-    float limit = kept ? 4.0 * splitLength : max(splitLength, sqrt(edge2));  // kMaxUnsplitEdge
+    float limit = kept ? 4.0 * uSplitLength : max(splitLength, sqrt(edge2));  // kMaxUnsplitEdge
     float b = dot(e0, dv);
     float disc = max(0.0, b * b - a * (edge2 - limit * limit));
     tMax = min(tMax, (-b + sqrt(disc)) / a);
