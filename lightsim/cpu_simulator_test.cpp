@@ -592,23 +592,28 @@ TEST(CpuSimulator, SameBitsWhateverTheThreadCount) {
 // Light trapped by total internal reflection (more than 16 reflections of its corners in all) stops
 // and is unfinished light, not killed light: a small patch in the middle of a glass block going
 // down, given the reflections of a trapped one, and the same patch one reflection short of it.
+// A square patch of half edge e at the centre of `sampler`'s volume, in the plane y = 0, going down.
+Patch squarePatchGoingDown(const VolumeSampler& sampler, double e) {
+  Patch patch;
+  const glm::dvec3 corners[4] = {{-e, 0.0, -e}, {e, 0.0, -e}, {e, 0.0, e}, {-e, 0.0, e}};
+  for (int c = 0; c < 4; ++c) {
+    patch.x[c] = corners[c];
+    patch.medium[c] = sampler.materialAt(patch.x[c]);
+    patch.w[c] = sampler.materialOptics(patch.medium[c], patch.x[c]).x * glm::dvec3(0.0, -1.0, 0.0);
+  }
+  patch.flux = glm::dvec3(1e-3);
+  patch.area0 = patch.area();
+  return patch;
+}
+
 TEST(CpuSimulator, APatchPastSixteenTotalInternalReflectionsIsTrappedNotKilled) {
   const Volume v = sharpVolume("procedural:box,size=0.8:0.8:0.8,center=0:0:0,ior=1.5", 24, cube(0.5));
   const VolumeSampler sampler(v);
   SimulationOptions options;
   const StepContext ctx = makeStepContext(sampler, options, 1.0);
   for (const int reflections : {16, 17}) {
-    Patch patch;
-    const double e = 0.01;
-    const glm::dvec3 corners[4] = {{-e, 0.0, -e}, {e, 0.0, -e}, {e, 0.0, e}, {-e, 0.0, e}};
-    for (int c = 0; c < 4; ++c) {
-      patch.x[c] = corners[c];
-      patch.medium[c] = sampler.materialAt(patch.x[c]);
-      patch.w[c] = sampler.materialOptics(patch.medium[c], patch.x[c]).x * glm::dvec3(0.0, -1.0, 0.0);
-    }
+    Patch patch = squarePatchGoingDown(sampler, 0.01);
     ASSERT_GE(patch.medium[0], 0);  // inside the glass
-    patch.flux = glm::dvec3(1e-3);
-    patch.area0 = patch.area();
     patch.reflections = reflections;
     PatchSamples samples = samplePatch(patch, sampler);
     const PatchStepResult r = stepPatch(patch, samples, ctx);
@@ -632,17 +637,8 @@ TEST(CpuSimulator, AReflectedWavefrontSplitsAtFourSplitLengths) {
   const double split = splitThreshold(sampler.grid(), options);
   for (const double edges : {2.0, 5.0}) {
     for (const int bounce : {0, 1}) {
-      Patch patch;
-      const double e = 0.5 * edges * split;
-      const glm::dvec3 corners[4] = {{-e, 0.0, -e}, {e, 0.0, -e}, {e, 0.0, e}, {-e, 0.0, e}};
-      for (int c = 0; c < 4; ++c) {
-        patch.x[c] = corners[c];
-        patch.medium[c] = sampler.materialAt(patch.x[c]);
-        patch.w[c] = sampler.materialOptics(patch.medium[c], patch.x[c]).x * glm::dvec3(0.0, -1.0, 0.0);
-      }
+      Patch patch = squarePatchGoingDown(sampler, 0.5 * edges * split);
       ASSERT_EQ(patch.medium[0], 0);  // inside the glass
-      patch.flux = glm::dvec3(1e-3);
-      patch.area0 = patch.area();
       patch.bounce = bounce;
       PatchSamples samples = samplePatch(patch, sampler);
       const PatchStepResult r = stepPatch(patch, samples, ctx);
