@@ -152,12 +152,12 @@ struct GpuSimulator::Impl {
     if (!p) p = std::make_unique<gpu::UpdatePass>(library, i, volumeDefines, flight, absorbers);
     return *p;
   }
-  // The maps a run of `options` reads: free flight where the run has no volume deposits (the track
-  // deposit pass bounds a step's extent), straight steps where straightSteps allows them (an
-  // absorbing volume's only where its absorber map finds σa = 0).
+  // The maps a run of `options` reads: free flight with track deposits (with volume deposits only
+  // as far as the track deposit pass reaches, StepUniforms::flightExtentVoxels), straight steps
+  // where straightSteps allows them (an absorbing volume's only where its absorber map finds σa = 0).
   gpu::UpdateMaps updateMaps(const SimulationOptions& options, bool track) {
     gpu::UpdateMaps maps;
-    if (options.free_flight && track && !options.volume_deposits) {
+    if (options.free_flight && track) {
       if (!quietTable) quietTable = gpu::QuietTexture(sampler.quietMap());
       if (quietTable) maps.quiet = &quietTable;
     }
@@ -356,6 +356,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     const double extent = 2.0 * kMaxUnsplitEdge * options.split_voxels + options.step_voxels;
     trackUniforms.maxExtentVoxels =
         std::min(trackPassFor().maxExtentVoxels(), static_cast<int>(std::ceil(1.5 * extent)) + 2);
+    if (options.volume_deposits) step.flightExtentVoxels = static_cast<float>(trackUniforms.maxExtentVoxels);
   }
   const gpu::AnalysisPass& analysisPass = analyse(options.deposit, track, options.receiver.has_value());
   const bool extraLedger = sharp || options.receiver.has_value();

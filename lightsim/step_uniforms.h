@@ -18,6 +18,9 @@ struct StepUniforms {
   // the corners (its time / min(1, min n)), the box the absorber map must find σa = 0 in.
   float stepDt = 0.0f, straightReach = 0.0f;
   float flightCap = 0.0f;                       // free flight: the propagation box's diagonal
+  // Free flight with volume deposits: the track deposit pass's bound on a step's extent, in voxels
+  // (TrackDepositUniforms::maxExtentVoxels); 0: none (no volume deposits).
+  float flightExtentVoxels = 0.0f;
   float boundaryOn = 0.0f, boundaryOff = 0.0f;  // g_on, g_off
   float fluxKill = 0.0f;                        // flux_threshold · Φ_ref
   float splitLength = 0.0f;                     // split_voxels · h · (1 + margin)

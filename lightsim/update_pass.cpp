@@ -52,6 +52,7 @@ void UpdatePass::run(const PatchTextures& in, PatchTextures& out, std::size_t co
   program_.set("uStepDt", step.stepDt);
   program_.set("uStraightReach", step.straightReach);
   program_.set("uFlightCap", step.flightCap);
+  program_.set("uFlightExtentVoxels", step.flightExtentVoxels);
   program_.set("uKeepAtMaxDepth", !step.killAtMaxDepth);
   program_.set("uBoundaryOn", step.boundaryOn);
   program_.set("uBoundaryOff", step.boundaryOff);

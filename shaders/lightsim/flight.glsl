@@ -7,7 +7,8 @@
 //                 nothing absorbs within their reach
 // Both tables count noisy bricks of uQuietBrick³ voxels, (bricks + 1)³ entries per table
 // (lightsim/quiet_texture.h). The GPU path flies only where σa = 0, so that the analysis pass's
-// step 2 (recomputed with Δt) is exp(0) = 1 whatever the step was.
+// step 2 (recomputed with Δt) is exp(0) = 1 whatever the step was, and with volume deposits only
+// as far as the track deposit pass reaches.
 
 uniform float uStepDt;        // a straight step's time (straight_step_voxels·h), or Δt when off
 uniform int uQuietBrick;      // voxels per brick edge
@@ -15,6 +16,9 @@ uniform int uQuietBrick;      // voxels per brick edge
 uniform usampler3D uQuietSat;
 uniform float uFlightCap;     // the propagation box's diagonal (ctx.flight_cap)
 uniform bool uKeepAtMaxDepth; // DepthLimit::Keep
+// With volume deposits: the track deposit pass's bound on a patch-step's extent, in voxels of each
+// axis (TrackDepositUniforms::maxExtentVoxels); 0: no bound (the receiver map only).
+uniform float uFlightExtentVoxels;
 #endif
 #ifdef ABSORBER_MAP
 uniform usampler3D uAbsorberSat;
@@ -55,11 +59,30 @@ bool flightQuiet(Patch p, vec3 v[4], float t0, float t1) {
   return boxQuiet(uQuietSat, lo, hi);
 }
 
+// Whether the whole flight from 0 to t stays within the track deposit pass's bound: the box of the
+// corners at 0 and t (all of the flight: each corner moves on a line), clamped to the grid as the
+// pass clamps it (track_deposit.vert), at most uFlightExtentVoxels voxels along every axis.
+bool flightFits(Patch p, vec3 v[4], float t) {
+  if (!(uFlightExtentVoxels > 0.0)) return true;
+  vec3 lo = vec3(3.4e38), hi = vec3(-3.4e38);
+  for (int c = 0; c < 4; ++c) {
+    vec3 end = p.x[c] + t * v[c];
+    lo = min(lo, min(p.x[c], end));
+    hi = max(hi, max(p.x[c], end));
+  }
+  vec3 voxelSize = (uBoundsMax - uBoundsMin) / vec3(uDims);
+  vec3 top = vec3(uDims) + 2.0;
+  vec3 vlo = clamp((lo - uBoundsMin) / voxelSize, vec3(-4.0), top);
+  vec3 vhi = clamp((hi - uBoundsMin) / voxelSize, vec3(-4.0), top);
+  return all(lessThanEqual(vhi - vlo, vec3(uFlightExtentVoxels)));
+}
+
 // freeFlightTime (cpu_simulator.cpp): the time of one straight step for the whole patch, or 0 for
 // an ordinary step. Every corner moves on its straight ray, so the swept patch lies in the box of
 // its corners at 0 and t, checked piece by piece ([good, t] of the doubling and of the bisection);
 // t is doubled from 2Δt while the path is quiet, then refined by three bisections, bounded so that no edge grows past the split length (or its length now, if longer;
-// at the depth limit, as far as a kept patch goes) and by uFlightCap.
+// at the depth limit, as far as a kept patch goes), by uFlightCap and, with volume deposits, by
+// the track deposit pass's extent (flightFits; the twin's flights are not bounded so).
 float freeFlightTime(Patch p) {
 #ifdef SHARP_INTERFACES
   if (!oneMedium(p) || p.crossed != 0 || p.reflectPending != 0.0) return 0.0;
@@ -100,7 +123,7 @@ float freeFlightTime(Patch p) {
   float good = 0.0, bad = 0.0;
   for (float t = 2.0 * uDt;; t *= 2.0) {
     float tt = min(t, tMax);
-    if (!flightQuiet(p, v, good, tt)) {
+    if (!flightQuiet(p, v, good, tt) || !flightFits(p, v, tt)) {
       bad = tt;
       break;
     }
@@ -111,7 +134,7 @@ float freeFlightTime(Patch p) {
   if (bad > 0.0)
     for (int i = 0; i < 3; ++i) {
       float mid = 0.5 * (good + bad);
-      if (flightQuiet(p, v, good, mid)) good = mid;
+      if (flightQuiet(p, v, good, mid) && flightFits(p, v, mid)) good = mid;
       else bad = mid;
     }
   return good;
