@@ -72,8 +72,8 @@ int run(int argc, char** argv) {
   std::string free_flight = "on";
   app.add_option("--free-flight", free_flight,
                  "on (default: a patch crosses quiet space, where n is constant and no interface lies, in one "
-                 "straight step; the same bake in fewer steps; the GPU path only where nothing absorbs and, with "
-                 "volume deposits, as far as its deposit pass reaches) or off (steps of --step everywhere)")
+                 "straight step; the same bake in fewer steps; with volume deposits the GPU path flies only as "
+                 "far as its deposit pass reaches) or off (steps of --step everywhere)")
       ->check(CLI::IsMember({"on", "off"}));
   options.straight_step_voxels = 2.0;
   app.add_option("--straight-step", options.straight_step_voxels,

@@ -78,8 +78,8 @@ struct SimulationOptions {
   int max_steps = 0;              // 0: 4 × the grid diagonal in steps
   // Free flight (ALGORITHM.md "Free flight"): a patch whose swept box is quiet (quiet_map.h) takes
   // one straight step across it instead of steps of Δt. Needs the track kernel (accumulate);
-  // ignored otherwise. The GPU path flies only where σa = 0 and, with volume deposits, as far as
-  // its track deposit pass reaches (shaders/lightsim/flight.glsl). `lightsim` turns it on (--free-flight); off here so that the
+  // ignored otherwise. With volume deposits the GPU path flies only as far as its track deposit
+  // pass reaches (shaders/lightsim/flight.glsl). `lightsim` turns it on (--free-flight); off here so that the
   // twin and the GPU path compare step for step.
   bool free_flight = false;
   // Straight steps (ALGORITHM.md "Straight steps"): in a sharp volume whose materials all have a

@@ -59,6 +59,19 @@ bool footprintExists(Patch p) {
 }
 #endif
 
+// Step 2's factor a as the update pass applied it, read from its result: Φ = Φ_old · a · T_fresnel
+// per channel. The step's time (Δt, a straight step's or a free flight's) is the update's alone.
+// Where σa(m_old) = 0, a = 1 exactly; 1 where no flux came in.
+vec3 stepAbsorptionFactor(vec3 mOld, vec3 fluxOld, vec3 flux, float tFresnel) {
+  if (all(equal(sampleSigmaA(mOld), vec3(0.0)))) return vec3(1.0);
+  vec3 a = vec3(1.0);
+  for (int c = 0; c < 3; ++c) {
+    float before = fluxOld[c] * tFresnel;
+    if (before > 0.0) a[c] = flux[c] / before;
+  }
+  return a;
+}
+
 void main() {
   ivec2 texel = ivec2(gl_FragCoord.xy);
   oDepositA = vec4(0.0, 0.0, 0.0, -1.0);
@@ -93,7 +106,7 @@ void main() {
     oLedgerA = vec4(0.0, 0.0, 0.0, float(FATE_DEPTH));
     return;
   }
-  vec3 a = sharpAbsorptionFactor(mOld, uDt);
+  vec3 a = stepAbsorptionFactor(mOld, fluxOld, p.flux, p.tFresnel);
   vec3 reflected = fluxOld * a * (1.0 - p.tFresnel);
   // The reflected wavefront leaves the interface once every corner is through (bounces).
   bool spawns = false;
@@ -107,7 +120,7 @@ void main() {
   int blocked = p.event / SHARP_EVENT_BLOCKED;
   bool splittable = oneMedium(p) && blocked == 0;
 #else
-  vec3 a = absorptionFactor(mOld, uDt);
+  vec3 a = stepAbsorptionFactor(mOld, fluxOld, p.flux, p.tFresnel);
   vec3 reflected = p.tFresnel < 1.0 ? fluxOld * a * (1.0 - p.tFresnel) : vec3(0.0);
   bool spawns = false;
   vec3 spawnFlux = vec3(0.0);
@@ -136,8 +149,8 @@ void main() {
   else fate = patchFate(p, splittable);
   oCount = vec4(fateCount(fate) + (spawns ? 1.0 : 0.0), 0.0, 0.0, 0.0);
 
-  // The ledger: step 2's factor recomputed exactly as update.frag did (same inputs, same code),
-  // step 3's reflection from it and T_fresnel, less what a followed reflection carries on.
+  // The ledger: step 2's factor as update.frag applied it (stepAbsorptionFactor), step 3's
+  // reflection from it and T_fresnel, less what a followed reflection carries on.
   oLedgerA = vec4(fluxOld * (1.0 - a), float(fate + (spawns ? FATE_SPAWNS : 0)));
   if (p.tFresnel < 1.0 || spawns) oLedgerB = vec4(reflected - (spawns ? spawnFlux : vec3(0.0)), p.tFresnel < 1.0 ? 1.0 : 0.0);
 

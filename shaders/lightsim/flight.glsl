@@ -6,9 +6,8 @@
 //   ABSORBER_MAP  the absorber map's (σa ≠ 0 voxels) to uAbsorberSat: straight steps only where
 //                 nothing absorbs within their reach
 // Both tables count noisy bricks of uQuietBrick³ voxels, (bricks + 1)³ entries per table
-// (lightsim/quiet_texture.h). The GPU path flies only where σa = 0, so that the analysis pass's
-// step 2 (recomputed with Δt) is exp(0) = 1 whatever the step was, and with volume deposits only
-// as far as the track deposit pass reaches.
+// (lightsim/quiet_texture.h). With volume deposits the GPU path flies only as far as the track
+// deposit pass reaches.
 
 uniform float uStepDt;        // a straight step's time (straight_step_voxels·h), or Δt when off
 uniform int uQuietBrick;      // voxels per brick edge
@@ -89,7 +88,6 @@ float freeFlightTime(Patch p) {
 #else
   if (p.nIn != 0.0) return 0.0;  // inside a boundary layer: its Fresnel exit is decided step by step
 #endif
-  if (any(notEqual(sampleSigmaA(p.x[0]), vec3(0.0)))) return 0.0;  // the GPU path flies where σa = 0
   vec3 v[4];
   float n[4];
   for (int c = 0; c < 4; ++c) {

@@ -5,7 +5,7 @@
 //   1. Update (thesis §6.2.2): per corner, the time-parameterised ray equation (Eq. 4.12/4.13)
 //      x' = w/n², w' = ∇n/n, stepped with Euler (Eq. 6.1/6.2), RK2 (midpoint) or RK4
 //      (INTEGRATOR_EULER / _RK2 / _RK4), then w renormalised to n at the new position.
-//   2. Absorption: Φ ← Φ·exp(−σa(m_old)·Δs_m), Δs_m = Δt / n(m_old) (Eq. 4.11).
+//   2. Absorption: Φ ← Φ·exp(−σa(m_old)·Δs_m), Δs_m = Δt / n(m_old) (Eq. 4.11), Δt the step's time.
 //   3. Fresnel boundary tracking (docs/physics.md): enter a layer when |∇n(m_new)|·h > g_on, leave it
 //      when < g_off and keep the transmitted fraction 1 − R (boundaryReflectance, fresnel.glsl).
 // SHARP_INTERFACES (ALGORITHM.md "Sharp interfaces"; the CPU twin's stepPatch): each corner
@@ -130,15 +130,16 @@ void main() {
 #ifdef FREE_FLIGHT
   flight = freeFlightTime(p);
 #endif
+  float stepTime = flight;  // the step's time: the flight's, a straight step's or Δt
   if (flight > 0.0) {
     for (int c = 0; c < 4; ++c) {
       float n = materialOptics(p.medium[c], p.x[c]).x;
       p.x[c] += flight * p.w[c] / (n * n);  // Eq. 6.1, exact for a straight ray
     }
   } else {
-    float dt = sharpStepTime(p);
+    stepTime = sharpStepTime(p);
     for (int c = 0; c < 4; ++c) {
-      CornerCrossings cc = advanceCornerSharp(p.x[c], p.w[c], p.medium[c], dt);
+      CornerCrossings cc = advanceCornerSharp(p.x[c], p.w[c], p.medium[c], stepTime);
       if (cc.transmitted > 0 || cc.reflected > 0 || cc.blocked) metMask |= 1 << c;
       reflections += cc.reflected;
       blocked += cc.blocked ? 1 : 0;
@@ -166,8 +167,8 @@ void main() {
     }
   }
 
-  // Step 2: absorption at the old midpoint, n of its material there.
-  p.flux *= sharpAbsorptionFactor(mOld, uDt);
+  // Step 2: absorption at the old midpoint over the step, n of its material there.
+  p.flux *= sharpAbsorptionFactor(mOld, stepTime);
 
   // Step 3: Fresnel at the interfaces the corners crossed; the reflected fraction is remembered
   // until every corner is through (the analysis may then follow the reflected wavefront).
@@ -204,8 +205,8 @@ void main() {
     for (int c = 0; c < 4; ++c) stepCorner(p.x[c], p.w[c]);
   }
 
-  // Step 2: absorption at the old midpoint.
-  p.flux *= absorptionFactor(mOld, uDt);
+  // Step 2: absorption at the old midpoint over the step.
+  p.flux *= absorptionFactor(mOld, flight > 0.0 ? flight : uDt);
 
   // Step 3: Fresnel boundary tracking.
   vec3 mNew = patchMidpoint(p);
