@@ -224,21 +224,32 @@ TEST(GpuSimulatorTest, SharpSphereOverAFloorWithTrackDepositsAndReceiverMatchesC
   }
 }
 
+// A sharp glass sphere (R = 0.5, n = 1.5) over a floor 0.75 below its centre, the sun tilted,
+// max depth 4: the scene of the tests below, and its options (receiver on the floor).
+struct TiltedSphereOverAFloor {
+  Volume volume = test_scenes::sharpVolume("procedural:sphere,r=0.5,ior=1.5", 32,
+                                           Bounds{{-1.0, -0.8, -1.0}, {1.0, 0.6, 1.0}});
+  LightSpec light;
+  SimulationOptions options;
+  TiltedSphereOverAFloor() {
+    light.direction = glm::normalize(glm::dvec3(0.2, -1.0, 0.1));
+    options.max_depth = 4;
+    ReceiverSpec floor;
+    floor.point = {0.0, -0.75, 0.0};
+    floor.half_extent = 1.0;
+    options.receiver = floor;
+  }
+};
+
 // Free flight with volume deposits (lightsim's default for a scattering or opaque object): the
 // GPU path flies only as far as its track deposit pass reaches (flight.glsl flightFits), the twin
 // as far as the quiet space goes; both flights are exact for track deposits, so the bakes agree
 // as the stepped ones do, in far fewer patch-steps than the GPU path's steps of Δt.
 TEST(GpuSimulatorTest, WithVolumeDepositsTheGpuPathFliesAsFarAsItsTrackDepositsReach) {
-  const Volume volume = test_scenes::sharpVolume("procedural:sphere,r=0.5,ior=1.5", 32,
-                                                 Bounds{{-1.0, -0.8, -1.0}, {1.0, 0.6, 1.0}});
-  LightSpec light;
-  light.direction = glm::normalize(glm::dvec3(0.2, -1.0, 0.1));
-  SimulationOptions stepped;
-  stepped.max_depth = 4;
-  ReceiverSpec floor;
-  floor.point = {0.0, -0.75, 0.0};
-  floor.half_extent = 1.0;
-  stepped.receiver = floor;
+  const TiltedSphereOverAFloor scene;
+  const Volume& volume = scene.volume;
+  const LightSpec& light = scene.light;
+  const SimulationOptions& stepped = scene.options;
   SimulationOptions flying = stepped;
   flying.free_flight = true;
   GpuSimulatorOptions exact;
@@ -270,16 +281,10 @@ TEST(GpuSimulatorTest, WithVolumeDepositsTheGpuPathFliesAsFarAsItsTrackDepositsR
 // ledger to the bit as with them: the deposits only read the step's results. The free flight of
 // `lightsim`'s default is on for the twin, whose quiet map is read only by the step.
 TEST(GpuSimulatorTest, WithoutVolumeDepositsTheReceiverMapAndLedgerAreTheSameToTheBit) {
-  const Volume volume = test_scenes::sharpVolume("procedural:sphere,r=0.5,ior=1.5", 32,
-                                                 Bounds{{-1.0, -0.8, -1.0}, {1.0, 0.6, 1.0}});
-  LightSpec light;
-  light.direction = glm::normalize(glm::dvec3(0.2, -1.0, 0.1));
-  SimulationOptions options;
-  options.max_depth = 4;
-  ReceiverSpec floor;
-  floor.point = {0.0, -0.75, 0.0};
-  floor.half_extent = 1.0;
-  options.receiver = floor;
+  const TiltedSphereOverAFloor scene;
+  const Volume& volume = scene.volume;
+  const LightSpec& light = scene.light;
+  const SimulationOptions& options = scene.options;
   SimulationOptions without = options;
   without.volume_deposits = false;
   test_scenes::glContext();
