@@ -326,9 +326,11 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   gpu::StepUniforms step = gpu::StepUniforms::from(localGrid(grid, origin), options, fluxRef);
   const gpu::UpdateMaps maps = updateMaps(options, track);
   info.volume_bytes = volume.bytes() + quietTable.bytes() + absorberTable.bytes();
-  if (straightSteps(sampler, options) && (!sampler.hasAbsorption() || maps.absorbers)) {
-    step.stepDt = static_cast<float>(options.straight_step_voxels * voxelEdge(grid));
-    step.straightReach = static_cast<float>(step.stepDt / std::min(1.0, sampler.minIor()));
+  {
+    // A straight step's time and reach, as the twin takes them (Δt where they do not apply).
+    const StepContext twin = makeStepContext(sampler, options, fluxRef);
+    step.stepDt = static_cast<float>(twin.step_dt);
+    step.straightReach = static_cast<float>(twin.straight_reach);
   }
   if (options.receiver) {
     step.receiverPoint = glm::vec3(receiver.point - origin);
