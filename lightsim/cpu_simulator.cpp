@@ -379,17 +379,19 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
     if (patch.crossed == 0xF) {
       // Every corner is through: the reflected wavefront leaves the interface now (bounces).
       const glm::dvec3 reflected_flux = patch.flux * (patch.reflect_pending / (1.0 - patch.reflect_pending));
+      Patch reflection;
       if (patch.bounce < options.bounces && patch.reflect_pending > 0.0 && patch.reflect_pending < 1.0 &&
           std::max(reflected_flux.x, std::max(reflected_flux.y, reflected_flux.z)) >=
               fluxKillThreshold(ctx.flux_ref, options, static_cast<int>(patch.depth)) &&
-          reflectedPatch(patch, sampler, 4.0 * ctx.step_dt + 2.0 * h, result.reflection)) {
+          reflectedPatch(patch, sampler, 4.0 * ctx.step_dt + 2.0 * h, reflection)) {
+        result.reflection = std::make_unique<Patch>(reflection);
         result.spawn_reflection = true;
-        result.reflection.flux = reflected_flux;
-        result.reflection.area0 = result.reflection.area();
-        result.reflection.bounce = patch.bounce + 1;
-        result.reflection.reflect_pending = 0.0;
-        result.reflection.crossed = 0;
-        result.reflection.t_fresnel = 1.0;
+        result.reflection->flux = reflected_flux;
+        result.reflection->area0 = result.reflection->area();
+        result.reflection->bounce = patch.bounce + 1;
+        result.reflection->reflect_pending = 0.0;
+        result.reflection->crossed = 0;
+        result.reflection->t_fresnel = 1.0;
       }
       patch.crossed = 0;
       patch.reflect_pending = 0.0;
@@ -788,7 +790,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
         // The reflected wavefront is followed: its flux is no longer lost to reflection.
         total += 1;
         ++stats.reflections;
-        stats.flux_reflected -= r.reflection.flux;
+        stats.flux_reflected -= r.reflection->flux;
       }
     }
     offsets[count] = total;
@@ -849,10 +851,10 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
           }
           if (r.spawn_reflection) {
             out += n_out;
-            next[out] = r.reflection;
-            next_samples[out] = samplePatch(r.reflection, sampler_);
+            next[out] = *r.reflection;
+            next_samples[out] = samplePatch(*r.reflection, sampler_);
             for (int c = 0; c < 4; ++c)
-              next_samples[out].corner[c] = sampler_.materialOptics(r.reflection.medium[c], r.reflection.x[c]);
+              next_samples[out].corner[c] = sampler_.materialOptics(r.reflection->medium[c], r.reflection->x[c]);
           }
         },
         256);

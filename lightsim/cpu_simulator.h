@@ -10,6 +10,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 
 #include "core/volume.h"
 #include "lightsim/simulator.h"
@@ -79,7 +80,7 @@ struct PatchStepResult {
   bool rolled_back = false;
   bool flight = false;             // a free flight (longer than Δt, straight)
   bool spawn_reflection = false;
-  Patch reflection;
+  std::unique_ptr<Patch> reflection;  // spawn_reflection: the reflected wavefront (none otherwise)
 };
 
 struct StepContext {
