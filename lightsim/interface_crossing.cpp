@@ -56,10 +56,9 @@ int materialBeyond(const VolumeSampler& sampler, const glm::dvec3& p, const glm:
 
 bool findInterface(const VolumeSampler& sampler, const glm::dvec3& a, const glm::dvec3& b, int from, InterfaceHit& hit) {
   // The end first: a chord that ends in the material it starts in crosses nothing (the common
-  // case, one lookup).
-  const glm::dvec4 db = sampler.distances(b);
-  if (materialSlot(db, sampler.slotCount()) == from) return false;
-  const glm::dvec4 da = sampler.distances(a);
+  // case, one lookup of a byte).
+  if (sampler.materialAt(b) == from) return false;
+  const glm::dvec4 db = sampler.distances(b), da = sampler.distances(a);
   // The slot surfaces the chord crosses, in order along it: the first that changes the material
   // is the interface (crossing an outer slot's surface inside an inner slot changes nothing).
   std::array<std::pair<double, int>, kMaxInterfaceSlots> crossings{};

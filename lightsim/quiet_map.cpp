@@ -97,7 +97,43 @@ std::vector<std::uint8_t>::reference QuietMap::brickFlag(std::vector<std::uint8_
                    (static_cast<std::size_t>(y / brick_) + static_cast<std::size_t>(bricks_.y) * static_cast<std::size_t>(z / brick_))];
 }
 
+void QuietMap::buildClearance(const std::vector<std::uint8_t>& flag) {
+  // The chessboard distance transform in two raster passes over the 26 neighbours (exact for this
+  // metric): forward from the 13 bricks before each one, backward from the 13 after it.
+  const int nx = bricks_.x, ny = bricks_.y, nz = bricks_.z;
+  clearance_.assign(flag.size(), 255);
+  for (std::size_t i = 0; i < flag.size(); ++i)
+    if (flag[i]) clearance_[i] = 0;
+  auto at = [&](int x, int y, int z) -> std::uint8_t& {
+    return clearance_[static_cast<std::size_t>(x) + static_cast<std::size_t>(nx) * (static_cast<std::size_t>(y) + static_cast<std::size_t>(ny) * static_cast<std::size_t>(z))];
+  };
+  auto pass = [&](int sign) {
+    const int x0 = sign > 0 ? 0 : nx - 1, y0 = sign > 0 ? 0 : ny - 1, z0 = sign > 0 ? 0 : nz - 1;
+    for (int z = z0; z >= 0 && z < nz; z += sign)
+      for (int y = y0; y >= 0 && y < ny; y += sign)
+        for (int x = x0; x >= 0 && x < nx; x += sign) {
+          std::uint8_t& here = at(x, y, z);
+          if (here == 0) continue;
+          int best = here;
+          // The neighbours before (x, y, z) in this pass's raster order: the previous slice's nine,
+          // the previous row's three, the previous brick in the row.
+          for (int dz = -1; dz <= 0; ++dz)
+            for (int dy = -1; dy <= 1; ++dy)
+              for (int dx = -1; dx <= 1; ++dx) {
+                if (dz == 0 && (dy > 0 || (dy == 0 && dx >= 0))) continue;
+                const int qx = x + sign * dx, qy = y + sign * dy, qz = z + sign * dz;
+                if (qx < 0 || qy < 0 || qz < 0 || qx >= nx || qy >= ny || qz >= nz) continue;
+                best = std::min(best, at(qx, qy, qz) + 1);
+              }
+          here = static_cast<std::uint8_t>(std::min(best, 255));
+        }
+  };
+  pass(+1);
+  pass(-1);
+}
+
 void QuietMap::buildTable(const std::vector<std::uint8_t>& flag) {
+  buildClearance(flag);
   const std::size_t sx = static_cast<std::size_t>(bricks_.x) + 1, sy = static_cast<std::size_t>(bricks_.y) + 1;
   sat_.assign(sx * sy * (static_cast<std::size_t>(bricks_.z) + 1), 0);
   for (int k = 1; k <= bricks_.z; ++k)
@@ -131,6 +167,18 @@ bool QuietMap::quiet(const glm::dvec3& lo, const glm::dvec3& hi) const {
     b0[a] = v0 / brick_;
     b1[a] = v1 / brick_ + 1;  // exclusive
   }
+  // The middle brick's clearance: no noisy brick within it of the middle brick (chessboard), and
+  // the box reaches `reach` bricks from it; a noisy middle brick is in the box.
+  int mid[3], reach = 0;
+  for (int a = 0; a < 3; ++a) {
+    mid[a] = (b0[a] + b1[a] - 1) / 2;
+    reach = std::max(reach, std::max(mid[a] - b0[a], b1[a] - 1 - mid[a]));
+  }
+  const int clear = clearance_[static_cast<std::size_t>(mid[0]) +
+                               static_cast<std::size_t>(bricks_.x) *
+                                   (static_cast<std::size_t>(mid[1]) + static_cast<std::size_t>(bricks_.y) * static_cast<std::size_t>(mid[2]))];
+  if (clear > reach) return true;
+  if (clear == 0) return false;
   const std::uint32_t count = sat(b1[0], b1[1], b1[2]) - sat(b0[0], b1[1], b1[2]) - sat(b1[0], b0[1], b1[2]) -
                               sat(b1[0], b1[1], b0[2]) + sat(b0[0], b0[1], b1[2]) + sat(b0[0], b1[1], b0[2]) +
                               sat(b1[0], b0[1], b0[2]) - sat(b0[0], b0[1], b0[2]);

@@ -11,7 +11,10 @@
 // (∇n ≠ 0, a distance exactly 0, a graded material) or differs from a face neighbour, in which
 // case both bricks are noisy. A box of voxels without a noisy brick holds one signature (it is
 // connected through face neighbours, none of which differ), and a summed-area table over the flags
-// answers "is this box quiet?" with eight lookups.
+// answers "is this box quiet?" with eight lookups. Most boxes a flight asks about are answered
+// with one: each brick's clearance (its chessboard distance to the nearest noisy brick) says at
+// once that a box within it around its middle brick is quiet, or that a box around a noisy brick
+// is not; the table decides the rest.
 #pragma once
 
 #include <cstdint>
@@ -60,6 +63,10 @@ class QuietMap {
   // Summed-area table of the noisy flags, (bricks + 1)³ entries; entry (i, j, k) counts the noisy
   // bricks with indices below (i, j, k).
   std::vector<std::uint32_t> sat_;
+  // Per brick (x fastest), the chessboard distance in bricks to the nearest noisy brick: 0 for a
+  // noisy brick, at most 255 (also where none is noisy).
+  std::vector<std::uint8_t> clearance_;
+  void buildClearance(const std::vector<std::uint8_t>& brick_flags);
   // The brick size for the grid, and the summed-area table over per-brick flags.
   void chooseBricks();
   std::vector<std::uint8_t>::reference brickFlag(std::vector<std::uint8_t>& flags, int x, int y, int z) const;

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "lightsim/test_scenes.h"
@@ -130,6 +132,56 @@ TEST(QuietMap, FlaggedVoxelsMakeTheBoxesWhoseSamplesTouchThemNoisy) {
   const QuietMap absorbers = absorbing.absorberMap();
   EXPECT_FALSE(absorbers.quiet(glm::dvec3(-0.05), glm::dvec3(0.05)));
   EXPECT_TRUE(absorbers.quiet(glm::dvec3(0.42), glm::dvec3(0.5)));  // a corner of the grid, clear of it
+}
+
+// The answer from a brick's clearance (one lookup) is the summed-area table's (eight): random
+// boxes from a voxel to most of the grid, around scattered flagged voxels, against a brute-force
+// scan of the voxels every sample in the box takes as taps. At 200 voxels an axis the bricks are
+// 2³ voxels, so the scan is over bricks too.
+TEST(QuietMap, EveryBoxIsQuietExactlyWhenNoFlaggedBrickIsInIt) {
+  for (const int n : {24, 200}) {
+    const GridSpec grid = cubicGrid(n, 0.5);
+    std::mt19937 rng(7);
+    std::uniform_int_distribution<int> voxel(0, n - 1);
+    std::vector<std::uint8_t> flags(grid.count(), 0);
+    const int flagged = n == 24 ? 30 : 300;
+    for (int i = 0; i < flagged; ++i) flags[grid.index(voxel(rng), voxel(rng), voxel(rng))] = 1;
+    const QuietMap map(grid, flags);
+    const int brick = map.brickVoxels();
+    EXPECT_EQ(brick, n <= 160 ? 1 : 2);
+    std::vector<std::uint8_t> brick_flag(static_cast<std::size_t>(map.bricks().x) * map.bricks().y * map.bricks().z, 0);
+    for (int z = 0; z < n; ++z)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x)
+          if (flags[grid.index(x, y, z)])
+            brick_flag[static_cast<std::size_t>(x / brick + map.bricks().x * (y / brick + map.bricks().y * (z / brick)))] = 1;
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    int quiet = 0, boxes = 3000;
+    for (int b = 0; b < boxes; ++b) {
+      // Voxel coordinates of the box's corners: an edge of up to a voxel, eight, or half the grid.
+      const double scale = b % 3 == 0 ? 1.0 : b % 3 == 1 ? 8.0 : 0.5 * n;
+      glm::dvec3 q0, q1;
+      int v0[3], v1[3];
+      for (int a = 0; a < 3; ++a) {
+        q0[a] = -2.0 + unit(rng) * (n + 4.0);
+        q1[a] = q0[a] + unit(rng) * scale;
+        // The taps of the samples in [q0, q1] on this axis (quiet_map.cpp, trilinearTaps).
+        v0[a] = static_cast<int>(std::floor(std::clamp(q0[a] - 0.5, 0.0, n - 1.0)));
+        v1[a] = std::min(n - 1, static_cast<int>(std::floor(std::clamp(q1[a] - 0.5, 0.0, n - 1.0))) + 1);
+      }
+      bool any = false;
+      for (int z = v0[2] / brick; z <= v1[2] / brick && !any; ++z)
+        for (int y = v0[1] / brick; y <= v1[1] / brick && !any; ++y)
+          for (int x = v0[0] / brick; x <= v1[0] / brick && !any; ++x)
+            any = brick_flag[static_cast<std::size_t>(x + map.bricks().x * (y + map.bricks().y * z))] != 0;
+      const bool answer = map.quiet(grid.bounds_min + q0 * (1.0 / n), grid.bounds_min + q1 * (1.0 / n));
+      ASSERT_EQ(answer, !any) << "n " << n << " box " << b;
+      quiet += answer ? 1 : 0;
+    }
+    // Both answers are common, or the comparison proves little.
+    EXPECT_GT(quiet, boxes / 10) << n;
+    EXPECT_LT(quiet, boxes * 9 / 10) << n;
+  }
 }
 
 }  // namespace

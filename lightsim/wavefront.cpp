@@ -137,6 +137,28 @@ VolumeSampler::VolumeSampler(const Volume& volume) : grid_(volume.grid), h_(voxe
       for (std::size_t i = 0; i < n; ++i)
         for (int k = 0; k < used; ++k) used_distances_[i * static_cast<std::size_t>(used) + static_cast<std::size_t>(k)] = d.voxel(i)[k];
     }
+    // Each cell's material where its eight taps agree (materialAt).
+    const glm::ivec3 dims = grid_.dims;
+    cell_material_.assign(n, kMixedCell);
+    parallelFor(0, dims.z, [&](std::int64_t z64) {
+      const int z = static_cast<int>(z64), z1 = std::min(z + 1, dims.z - 1);
+      for (int y = 0; y < dims.y; ++y) {
+        const int y1 = std::min(y + 1, dims.y - 1);
+        for (int x = 0; x < dims.x; ++x) {
+          const int x1 = std::min(x + 1, dims.x - 1);
+          int inside = 0, outside = 0;  // bit k: slot k's distance < 0 (≥ 0) at some tap
+          for (int t = 0; t < 8; ++t) {
+            const float* v = d.voxel(grid_.index(t & 1 ? x1 : x, t & 2 ? y1 : y, t & 4 ? z1 : z));
+            for (int k = 0; k < used; ++k) (v[k] < 0.0f ? inside : outside) |= 1 << k;
+          }
+          if ((inside & outside) != 0) continue;  // a slot changes sign in the cell
+          std::int8_t material = -1;
+          for (int k = 0; k < used && material < 0; ++k)
+            if (inside & (1 << k)) material = static_cast<std::int8_t>(k);
+          cell_material_[grid_.index(x, y, z)] = material;
+        }
+      }
+    });
   }
   if (const Field* sa = volume.find("sigma_a")) {
     if (sa->components != 3) throw InputError("volume", "sigma_a", "expected 3 components");
@@ -154,6 +176,13 @@ double VolumeSampler::ior(const glm::dvec3& world) const { return iorAndGradient
 glm::dvec4 VolumeSampler::iorAndGradient(const glm::dvec3& world) const {
   if (sharp()) return materialOptics(materialAt(world), world);
   return interpolate<glm::dvec4>(ior_grad_, grid_, taps3(grid_, world, grid_.extent()));
+}
+
+int VolumeSampler::materialAt(const glm::dvec3& world) const {
+  if (!sharp()) return -1;
+  const Taps3 t = taps3(grid_, world, grid_.extent());
+  const std::int8_t cell = cell_material_[grid_.index(t.x.i0, t.y.i0, t.z.i0)];
+  return cell != kMixedCell ? cell : materialSlot(distances(world), slotCount());
 }
 
 glm::dvec4 VolumeSampler::distances(const glm::dvec3& world) const {

@@ -16,6 +16,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -115,8 +116,9 @@ class VolumeSampler {
   int slotCount() const { return static_cast<int>(table_.slots.size()); }
   // The slot distances d_k at a point (trilinear, clamp-to-edge); unused slots read +band.
   glm::dvec4 distances(const glm::dvec3& world) const;
-  // The material slot a point is in (−1: air).
-  int materialAt(const glm::dvec3& world) const { return sharp() ? materialSlot(distances(world), slotCount()) : -1; }
+  // The material slot a point is in (−1: air): materialSlot(distances(world)), read from the
+  // lookup's cell where all eight taps agree on it (one byte instead of the distances' eight taps).
+  int materialAt(const glm::dvec3& world) const;
   // n and ∇n inside material `slot` at `world`: (n_k, 0) for a homogeneous slot, the ior and ior_grad
   // fields for a graded one, (1, 0) for air (−1). Without sharp interfaces: iorAndGradient.
   glm::dvec4 materialOptics(int slot, const glm::dvec3& world) const;
@@ -143,6 +145,11 @@ class VolumeSampler {
   // slots' one value; empty where those vary (then distances_ is read).
   std::vector<float> used_distances_;
   float unused_distance_ = 0.0f;
+  // Per lookup cell (indexed by its first tap, i₀ + dims.x·(j₀ + dims.y·k₀); its taps i₀ and
+  // min(i₀ + 1, dims − 1) per axis): the material every point of it is in when each slot's
+  // distance has one sign at all eight taps (then so has their trilinear blend), else kMixedCell.
+  static constexpr std::int8_t kMixedCell = -2;
+  std::vector<std::int8_t> cell_material_;
 };
 
 // ---------------------------------------------------------------------------------------------

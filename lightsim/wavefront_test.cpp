@@ -145,6 +145,37 @@ TEST(VolumeSampler, SlotDistancesAreTheInterfacesFieldsInterpolant) {
   }
 }
 
+// materialAt reads a cell's material from one byte where the cell's eight taps agree on it: at
+// random points, and at points on the surfaces (where the cells are mixed), it must be the
+// material of the interpolated distances, in scenes of one to three slots.
+TEST(VolumeSampler, TheMaterialAtAPointIsThatOfItsInterpolatedDistances) {
+  const std::vector<std::vector<std::string>> scenes = {
+      {"procedural:sphere,r=0.3,ior=1.5"},
+      {"procedural:wine_glass,height=0.8"},
+      {"procedural:layered_cube,size=0.8,radius=0.1"}};
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (const auto& specs : scenes) {
+    const Volume v = test_scenes::sharpVolume(specs, 24);
+    const VolumeSampler sampler(v);
+    const GridSpec& g = v.grid;
+    int per_material[5] = {0, 0, 0, 0, 0}, near_surface = 0;
+    for (int n = 0; n < 20000; ++n) {
+      const glm::dvec3 p = g.bounds_min + (glm::dvec3(u(rng), u(rng), u(rng)) * 1.1 - 0.05) * g.extent();
+      const glm::dvec4 d = sampler.distances(p);
+      const int want = materialSlot(d, sampler.slotCount());
+      ASSERT_EQ(sampler.materialAt(p), want) << specs[0] << " at point " << n;
+      ++per_material[want + 1];
+      double nearest = 1e30;
+      for (int k = 0; k < sampler.slotCount(); ++k) nearest = std::min(nearest, std::abs(d[k]));
+      if (nearest < sampler.h()) ++near_surface;
+    }
+    // Every material is met, and points within a voxel of a surface (mixed cells) too.
+    for (int m = -1; m < sampler.slotCount(); ++m) EXPECT_GT(per_material[m + 1], 50) << specs[0] << " material " << m;
+    EXPECT_GT(near_surface, 500) << specs[0];
+  }
+}
+
 TEST(VolumeSampler, RequiresIorAndGradient) {
   Volume v;
   v.grid = smallGrid();
