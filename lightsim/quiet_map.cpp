@@ -88,6 +88,8 @@ void QuietMap::chooseBricks() {
   const glm::ivec3 d = grid_.dims;
   const int longest = std::max(d.x, std::max(d.y, d.z));
   brick_ = longest <= 160 ? 1 : longest <= 512 ? 2 : 4;
+  brick_shift_ = brick_ == 1 ? 0 : brick_ == 2 ? 1 : 2;
+  voxel_size_ = grid_.voxelSize();
   bricks_ = (d + (brick_ - 1)) / brick_;
 }
 
@@ -154,7 +156,7 @@ void QuietMap::buildTable(const std::vector<std::uint8_t>& flag) {
 bool QuietMap::quiet(const glm::dvec3& lo, const glm::dvec3& hi) const {
   if (sat_.empty()) return false;
   int b0[3], b1[3];
-  const glm::dvec3 qlo = grid_.toVoxel(lo), qhi = grid_.toVoxel(hi);
+  const glm::dvec3 qlo = (lo - grid_.bounds_min) / voxel_size_, qhi = (hi - grid_.bounds_min) / voxel_size_;  // toVoxel
   for (int a = 0; a < 3; ++a) {
     if (!std::isfinite(qlo[a]) || !std::isfinite(qhi[a])) return false;
     // The taps of a sample at voxel coordinate q (centres at i + ½): floor(c) and floor(c) + 1 with
@@ -164,8 +166,8 @@ bool QuietMap::quiet(const glm::dvec3& lo, const glm::dvec3& hi) const {
     const double c1 = std::clamp(std::max(qlo[a], qhi[a]) - 0.5, 0.0, top);
     const int v0 = static_cast<int>(std::floor(c0));
     const int v1 = std::min(grid_.dims[a] - 1, static_cast<int>(std::floor(c1)) + 1);
-    b0[a] = v0 / brick_;
-    b1[a] = v1 / brick_ + 1;  // exclusive
+    b0[a] = v0 >> brick_shift_;  // v / brick_ (v ≥ 0)
+    b1[a] = (v1 >> brick_shift_) + 1;  // exclusive
   }
   // The middle brick's clearance: no noisy brick within it of the middle brick (chessboard), and
   // the box reaches `reach` bricks from it; a noisy middle brick is in the box.

@@ -57,7 +57,9 @@ class QuietMap {
 
  private:
   GridSpec grid_;
+  glm::dvec3 voxel_size_{1.0};  // grid_.voxelSize(), once (quiet divides by it, as toVoxel does)
   int brick_ = 2;
+  int brick_shift_ = 1;  // log₂ brick_
   glm::ivec3 bricks_{0};
   std::size_t noisy_ = 0;
   // Summed-area table of the noisy flags, (bricks + 1)³ entries; entry (i, j, k) counts the noisy
