@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The demo: sets up a fresh Debian 12 machine (if needed), builds Release (if needed), then
 # voxelizes, bakes and renders the thesis' scenes in assets/ headless (scripts/scene.sh) and writes
-# the pictures into demo-output/. About 5–6 minutes on two CPU cores once built (scripts/build.sh takes 3-4 more the first time).
+# the pictures into demo-output/. About a minute on two CPU cores once built (scripts/build.sh takes 3-4 more the first time).
 #   bash scripts/demo.sh [SCENE...] [--scale F]     (default: every scene, --scale 1)
 # --scale multiplies the scenes' resolutions; scripts/gallery.sh renders them at full size.
 set -euo pipefail
