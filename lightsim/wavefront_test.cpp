@@ -116,16 +116,18 @@ TEST(VolumeSampler, HandValuesOnALinearField) {
   EXPECT_EQ(s.sigmaA(world(1, 1, 1)), glm::dvec3(0.0));
 }
 
+// Sharp volumes of one (sphere), two (wine glass) and three (layered cube) material slots.
+const std::vector<std::vector<std::string>> kSharpScenes = {
+    {"procedural:sphere,r=0.3,ior=1.5"},
+    {"procedural:wine_glass,height=0.8"},
+    {"procedural:layered_cube,size=0.8,radius=0.1"}};
+
 // The slot distances read from the used slots alone (one to three floats a voxel) are the
 // trilinear interpolant of the interfaces field as it is (all four channels), and a field whose
 // unused channels vary is read whole.
 TEST(VolumeSampler, SlotDistancesAreTheInterfacesFieldsInterpolant) {
-  const std::vector<std::vector<std::string>> scenes = {
-      {"procedural:sphere,r=0.3,ior=1.5"},
-      {"procedural:wine_glass,height=0.8"},
-      {"procedural:layered_cube,size=0.8,radius=0.1"}};
   std::mt19937 rng(11);
-  for (const auto& specs : scenes) {
+  for (const auto& specs : kSharpScenes) {
     Volume v = test_scenes::sharpVolume(specs, 24);
     const int slots = static_cast<int>(interfaceTable(v).slots.size());
     for (int vary = 0; vary < 2; ++vary) {
@@ -149,13 +151,9 @@ TEST(VolumeSampler, SlotDistancesAreTheInterfacesFieldsInterpolant) {
 // random points, and at points on the surfaces (where the cells are mixed), it must be the
 // material of the interpolated distances, in scenes of one to three slots.
 TEST(VolumeSampler, TheMaterialAtAPointIsThatOfItsInterpolatedDistances) {
-  const std::vector<std::vector<std::string>> scenes = {
-      {"procedural:sphere,r=0.3,ior=1.5"},
-      {"procedural:wine_glass,height=0.8"},
-      {"procedural:layered_cube,size=0.8,radius=0.1"}};
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  for (const auto& specs : scenes) {
+  for (const auto& specs : kSharpScenes) {
     const Volume v = test_scenes::sharpVolume(specs, 24);
     const VolumeSampler sampler(v);
     const GridSpec& g = v.grid;
