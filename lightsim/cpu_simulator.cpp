@@ -674,7 +674,10 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
     ctx.receiver = &receiver;
   }
   double flux_ref = 0.0;
-  std::vector<Patch> patches = initialPatches(light, grid, sampler_, options, &flux_ref, ctx.receiver);
+  DirectCells direct;  // cells that go straight to the receiver's map: in closed form, not followed
+  std::vector<Patch> patches = initialPatches(light, grid, sampler_, options, &flux_ref, ctx.receiver, &direct);
+  std::vector<glm::dvec3> direct_flux;
+  if (direct.cells > 0) direct_flux = directMapLight(receiver, light, patches);
   ctx.flux_ref = flux_ref;
   ctx.dim_irradiance = kDimTrackFraction * brightestIrradiance(light, grid);
   stats.initial_patches = patches.size();
@@ -870,6 +873,10 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
     }
   }
   for (const Patch& p : patches) stats.flux_unfinished += p.flux;
+  // The direct light's cells: in, and received (after the run, so that the progress counts the
+  // followed light only).
+  stats.flux_in += direct.flux;
+  stats.flux_received += direct.flux;
 
   // Output fields.
   phase.restart();
@@ -896,7 +903,8 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   if (options.receiver) {
     // Planar irradiance: each texel's flux over its area.
     const double inv_area = 1.0 / (receiver.pitch * receiver.pitch);
-    const std::vector<glm::dvec3> texel_flux = receiver_flux->resolve();
+    std::vector<glm::dvec3> texel_flux = receiver_flux->resolve();
+    for (std::size_t t = 0; t < direct_flux.size(); ++t) texel_flux[t] += direct_flux[t];
     receiver.irradiance.resize(receiver.texelCount() * 3);
     for (std::size_t t = 0; t < receiver.texelCount(); ++t)
       for (int c = 0; c < 3; ++c) receiver.irradiance[3 * t + static_cast<std::size_t>(c)] = static_cast<float>(texel_flux[t][c] * inv_area);

@@ -277,8 +277,11 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   ReceiverMap receiver;
   if (options.receiver) receiver = receiverGeometry(*options.receiver, light, grid, boxLo, boxHi);
   double fluxRef = 0.0;
-  const std::vector<Patch> initial =
-      initialPatches(light, grid, sampler, options, &fluxRef, options.receiver ? &receiver : nullptr);
+  DirectCells direct;  // cells that go straight to the receiver's map: in closed form, not followed
+  const std::vector<Patch> initial = initialPatches(light, grid, sampler, options, &fluxRef,
+                                                    options.receiver ? &receiver : nullptr, &direct);
+  std::vector<glm::dvec3> directFlux;
+  if (direct.cells > 0) directFlux = directMapLight(receiver, light, initial);
   stats.initial_patches = initial.size();
   for (const Patch& p : initial) stats.flux_in += p.flux;
   if (initial.empty()) {  // the light misses the volume: an empty bake
@@ -288,8 +291,14 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     }
     if (options.receiver) {
       receiver.irradiance.assign(receiver.texelCount() * 3, 0.0f);
+      const double inv_area = 1.0 / (receiver.pitch * receiver.pitch);
+      for (std::size_t t = 0; t < directFlux.size(); ++t)
+        for (int c = 0; c < 3; ++c)
+          receiver.irradiance[3 * t + static_cast<std::size_t>(c)] = static_cast<float>(directFlux[t][c] * inv_area);
       bake.receivers.push_back(std::move(receiver));
     }
+    stats.flux_in += direct.flux;
+    stats.flux_received += direct.flux;
     stats.phase_seconds["init"] = phaseWatch.seconds();
     if (options.progress) options.progress(1.0);
     info.wall_seconds = runWatch.seconds();
@@ -474,13 +483,16 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   stats.kills.blocked = static_cast<std::uint64_t>(std::llround(ledger.sum(gpu::kBlocked).w));
   stats.flux_received = glm::dvec3(ledger.sum(gpu::kReceived));
   stats.flux_blocked = glm::dvec3(ledger.sum(gpu::kBlocked));
+  // The direct light's cells: in, and received (after the run: the progress counts followed light).
+  stats.flux_in += direct.flux;
+  stats.flux_received += direct.flux;
   stats.reflections = static_cast<std::uint64_t>(std::llround(ledger.sum(gpu::kSpawned).w));
   stats.rollbacks = static_cast<std::uint64_t>(std::llround(ledger.sum(gpu::kRolledBack).w));
 
   phaseWatch.restart();
   if (options.volume_deposits) atlas.toFields(bake.irradiance, bake.light_dir);
   if (options.receiver) {
-    receiverTarget.fill(receiver);
+    receiverTarget.fill(receiver, directFlux);
     bake.receivers.push_back(std::move(receiver));
   }
   stats.phase_seconds["output"] = phaseWatch.seconds();

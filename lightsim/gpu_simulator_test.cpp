@@ -308,6 +308,46 @@ TEST(GpuSimulatorTest, WithoutVolumeDepositsTheReceiverMapAndLedgerAreTheSameToT
   }
 }
 
+// The direct light on the receiver's map (SimulationOptions::direct_receiver_light, lightsim's
+// default): the cells of the tilted sun that meet the floor's map and not the sphere's box are put
+// on it in closed form (receiver.h directMapLight) instead of as patches going straight to it. On
+// both back ends the map is the one the patches give, to rounding (the CPU's double sums then
+// float: 10⁻⁷ relative L2; the GPU's float blending of a footprint per patch: 10⁻⁶), the ledger
+// balances with the same flux in and received (10⁻¹²), and the bake follows only the box's cells.
+TEST(GpuSimulatorTest, TheDirectLightOnTheMapBakesTheMapThePatchesGoingStraightToItDo) {
+  const TiltedSphereOverAFloor scene;
+  SimulationOptions direct = scene.options, patches = scene.options;
+  direct.volume_deposits = patches.volume_deposits = false;
+  direct.free_flight = patches.free_flight = true;
+  direct.direct_receiver_light = true;
+  patches.direct_receiver_light = false;
+  direct.receiver->half_extent = patches.receiver->half_extent = 2.5;  // beyond the box's shadow
+  test_scenes::glContext();
+  GpuSimulator gpu(scene.volume);
+  CpuSimulator cpu(scene.volume);
+  const std::pair<BakeResult, BakeResult> runs[] = {{gpu.run(scene.light, direct), gpu.run(scene.light, patches)},
+                                                    {cpu.run(scene.light, direct), cpu.run(scene.light, patches)}};
+  for (const auto& [d, p] : runs) {
+    SCOPED_TRACE(d.stats.backend);
+    ASSERT_EQ(d.receivers.size(), 1u);
+    ASSERT_EQ(p.receivers.size(), 1u);
+    const double e = relativeL2(d.receivers[0].irradiance, p.receivers[0].irradiance);
+    std::printf("%s: map relative L2 %.2e; initial patches %llu against %llu, patch-steps %llu against %llu\n",
+                d.stats.backend.c_str(), e, static_cast<unsigned long long>(d.stats.initial_patches),
+                static_cast<unsigned long long>(p.stats.initial_patches),
+                static_cast<unsigned long long>(d.stats.total_patches),
+                static_cast<unsigned long long>(p.stats.total_patches));
+    EXPECT_LT(e, d.stats.backend == "gl" ? 1e-5 : 1e-6);
+    const double in = luminance(p.stats.flux_in);
+    EXPECT_NEAR(luminance(d.stats.flux_in), in, 1e-12 * in);
+    EXPECT_NEAR(luminance(d.stats.flux_received), luminance(p.stats.flux_received), 1e-9 * in);
+    EXPECT_LT(d.stats.ledgerResidual(), 1e-9);
+    // Most of the floor's map is lit past the box: those cells are not followed.
+    EXPECT_LT(d.stats.initial_patches, p.stats.initial_patches / 2);
+    EXPECT_LE(d.stats.total_patches, p.stats.total_patches - (p.stats.initial_patches - d.stats.initial_patches));
+  }
+}
+
 // Voxels (with lum(irradiance) ≥ `floor`) whose GPU irradiance differs from the CPU's by more than
 // `tolerance` relative.
 int voxelsOff(const BakeResult& gpu, const BakeResult& cpu, double tolerance, double floor, int* considered) {

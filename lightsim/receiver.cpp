@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "lightsim/wavefront.h"
 
 namespace eik {
@@ -176,6 +177,52 @@ void depositConvex(const ReceiverMap& map, const glm::dvec2* polygon, int count,
 }
 
 }  // namespace
+
+std::vector<glm::dvec3> directMapLight(const ReceiverMap& map, const LightSpec& light,
+                                       const std::vector<Patch>& followed) {
+  const glm::dvec3 L = glm::normalize(light.direction);
+  const double facing = -glm::dot(L, map.normal);  // |L·n| for light that reaches the front
+  if (light.type != LightSpec::Type::Directional || !(facing > 0.0))
+    throw InputError("receiver", "light", "direct light on the map needs a directional light that reaches its front");
+  const std::size_t count = followed.size();
+  std::vector<std::array<glm::dvec2, 4>> footprints(count);
+  std::vector<std::uint8_t> lands(count, 0);
+  parallelFor(
+      0, static_cast<std::int64_t>(count),
+      [&](std::int64_t i) {
+        const std::size_t k = static_cast<std::size_t>(i);
+        lands[k] = patchFootprint(followed[k], map, footprints[k]) ? 1 : 0;
+      },
+      1024);
+  // What the followed patches would put on the map going straight, by bands of texel rows in
+  // parallel (each band adds the patches in order: the sums do not depend on the thread count).
+  std::vector<glm::dvec3> flux(map.texelCount(), glm::dvec3(0.0));
+  constexpr int kRows = FootprintSums::kBandRows;
+  const int bands = (map.texels.y + kRows - 1) / kRows;
+  parallelFor(0, bands, [&](std::int64_t band) {
+    const int r0 = static_cast<int>(band) * kRows, r1 = r0 + kRows;
+    const double y0 = map.origin.y + r0 * map.pitch, y1 = map.origin.y + r1 * map.pitch;
+    for (std::size_t k = 0; k < count; ++k) {
+      if (!lands[k]) continue;
+      const std::array<glm::dvec2, 4>& f = footprints[k];
+      const double lo = std::min(std::min(f[0].y, f[1].y), std::min(f[2].y, f[3].y));
+      const double hi = std::max(std::max(f[0].y, f[1].y), std::max(f[2].y, f[3].y));
+      if (hi < y0 || lo > y1) continue;
+      depositFootprint(map, f, followed[k].flux, flux, r0, r1);
+    }
+  });
+  // The light's flux over each texel less theirs (≥ 0: the two agree to rounding where the patches
+  // cover the texel wholly).
+  const glm::dvec3 full = light.power * (facing * map.pitch * map.pitch);
+  parallelFor(
+      0, static_cast<std::int64_t>(flux.size()),
+      [&](std::int64_t t) {
+        glm::dvec3& f = flux[static_cast<std::size_t>(t)];
+        f = glm::max(full - f, glm::dvec3(0.0));
+      },
+      4096);
+  return flux;
+}
 
 FootprintSums::FootprintSums(const ReceiverMap& map) : map_(map) {
   map_.irradiance.clear();

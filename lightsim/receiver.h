@@ -51,6 +51,16 @@ void depositFootprint(const ReceiverMap& map, const std::array<glm::dvec2, 4>& f
                       std::vector<glm::dvec3>& texel_flux, int row_begin = 0,
                       int row_end = std::numeric_limits<int>::max());
 
+// A directional light's light on the map where no followed patch carries it (ALGORITHM.md
+// "Receivers", direct light): per texel (W, texelCount() long), E_L·|L·n|·pitch² (the plane's
+// irradiance from the light over the texel) less the flux the initial patches `followed` would
+// put on it going straight (their corners' rays along L, depositFootprint), at least 0. The cells
+// that meet the map and not the box, left out of the list (initialPatches with DirectCells),
+// tile the rest of every texel, so the map gets what their footprints would give it, to rounding.
+// Throws InputError naming "receiver" when the light does not reach the plane's front.
+std::vector<glm::dvec3> directMapLight(const ReceiverMap& map, const LightSpec& light,
+                                       const std::vector<Patch>& followed);
+
 // The per-texel flux sums of a map being baked (the CPU twin's), with coarser levels for wide
 // footprints. A footprint whose box covers more than kFineFootprintTexels texels (dim light spread
 // thin: rays leaving an object at grazing angles, which land in long slivers across the map) goes to

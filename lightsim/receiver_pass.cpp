@@ -49,12 +49,13 @@ std::vector<glm::dvec3> ReceiverTarget::readFlux() const {
   return flux;
 }
 
-void ReceiverTarget::fill(ReceiverMap& map) const {
+void ReceiverTarget::fill(ReceiverMap& map, const std::vector<glm::dvec3>& extra_flux) const {
   if (map.texels != texels_)
     throw RuntimeError("ReceiverTarget::fill: a map of " + sizeText(map.texels) + " texels from a target of " +
                        sizeText(texels_));
   // The irradiance of a texel is its flux over its area (CpuSimulator::run, receiver.h).
-  const std::vector<glm::dvec3> flux = readFlux();
+  std::vector<glm::dvec3> flux = readFlux();
+  for (std::size_t t = 0; t < extra_flux.size() && t < flux.size(); ++t) flux[t] += extra_flux[t];
   const double inv_area = 1.0 / (map.pitch * map.pitch);
   map.irradiance.resize(flux.size() * 3);
   for (std::size_t t = 0; t < flux.size(); ++t)

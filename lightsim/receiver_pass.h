@@ -74,7 +74,8 @@ class ReceiverTarget {
   std::vector<glm::dvec3> readFlux() const;
   // Writes the irradiance = flux / pitch² into map.irradiance (RGB floats, u fastest), as the end
   // of CpuSimulator::run does. RuntimeError when map.texels is not this target's size.
-  void fill(ReceiverMap& map) const;
+  // `extra_flux` (W per texel, or empty): added to each texel's flux first (directMapLight).
+  void fill(ReceiverMap& map, const std::vector<glm::dvec3>& extra_flux = {}) const;
 
  private:
   glm::ivec2 texels_{0};

@@ -201,6 +201,73 @@ TEST(Receiver, WideFootprintsGoToCoarseLevelsAndKeepTheirFluxAndDensity) {
     }
 }
 
+// The direct light on the map (directMapLight) against the patches it stands for: a sun at 40°
+// over a small glass sphere's box, its map on the floor below. Every cell of the light's lattice
+// that meets the box or the map, each going straight to the floor as a patch (initialPatches
+// without DirectCells) and deposited there exactly (depositFootprint), is the reference; the
+// cells left out (with DirectCells) in closed form plus the followed patches' own footprints must
+// give the same flux to every texel, to rounding (10⁻¹²: sums of ~20 exact overlaps in double),
+// and the left-out cells must carry the flux the patches did (the ledger's in and received).
+TEST(Receiver, TheDirectLightIsWhatTheLeftOutCellsWouldPutOnTheMap) {
+  const Volume volume = test_scenes::sharpVolume("procedural:sphere,r=0.3,ior=1.5", 16, test_scenes::cube(0.5));
+  const VolumeSampler sampler(volume);
+  LightSpec light;
+  light.direction = glm::normalize(glm::dvec3(0.6, -1.0, -0.25));
+  light.power = {2.0, 1.0, 0.5};
+  ReceiverSpec spec;
+  spec.point = {0.0, -0.7, 0.0};
+  spec.half_extent = 1.2;
+  SimulationOptions options;
+  options.receiver = spec;
+  glm::dvec3 lo, hi;
+  propagationBox(volume.grid, options, lo, hi);
+  const ReceiverMap map = receiverGeometry(spec, light, volume.grid, lo, hi);
+
+  auto straightToMap = [&](const std::vector<Patch>& patches, std::vector<glm::dvec3>& flux) {
+    for (const Patch& p : patches) {
+      std::array<glm::dvec2, 4> f;
+      ASSERT_TRUE(patchFootprint(p, map, f));
+      depositFootprint(map, f, p.flux, flux);
+    }
+  };
+  const std::vector<Patch> all = initialPatches(light, volume.grid, sampler, options, nullptr, &map);
+  std::vector<glm::dvec3> reference(map.texelCount(), glm::dvec3(0.0));
+  straightToMap(all, reference);
+
+  DirectCells direct;
+  const std::vector<Patch> followed = initialPatches(light, volume.grid, sampler, options, nullptr, &map, &direct);
+  ASSERT_GT(direct.cells, 0u);
+  EXPECT_EQ(followed.size() + direct.cells, all.size());
+  EXPECT_LT(followed.size(), all.size() / 2);  // most of the map is lit directly
+  std::vector<glm::dvec3> flux = directMapLight(map, light, followed);
+  const glm::dvec3 texel_full = reference[0];  // a corner texel, far from the shadow: lit wholly
+  int partial = 0, dark = 0;
+  for (std::size_t t = 0; t < flux.size(); ++t) {
+    const double direct_part = flux[t].x / texel_full.x;
+    partial += direct_part > 1e-6 && direct_part < 1.0 - 1e-6 ? 1 : 0;
+    dark += direct_part < 1e-9 ? 1 : 0;
+  }
+  EXPECT_GT(partial, 0);  // texels the shadow's edge crosses
+  EXPECT_GT(dark, 0);     // texels wholly in the followed patches' shadow
+  straightToMap(followed, flux);
+  for (std::size_t t = 0; t < flux.size(); ++t)
+    for (int c = 0; c < 3; ++c) ASSERT_NEAR(flux[t][c], reference[t][c], 1e-12 * texel_full[c]) << t;
+  glm::dvec3 in_all(0.0), in_followed(0.0);
+  for (const Patch& p : all) in_all += p.flux;
+  for (const Patch& p : followed) in_followed += p.flux;
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(in_followed[c] + direct.flux[c], in_all[c], 1e-12 * in_all[c]);
+
+  // A point light keeps every cell a patch.
+  LightSpec point;
+  point.type = LightSpec::Type::Point;
+  point.position = {0.2, 1.5, 0.1};
+  const ReceiverMap point_map = receiverGeometry(spec, point, volume.grid, lo, hi);
+  DirectCells none;
+  initialPatches(point, volume.grid, sampler, options, nullptr, &point_map, &none);
+  EXPECT_EQ(none.cells, 0u);
+  EXPECT_THROW(directMapLight(point_map, point, {}), InputError);
+}
+
 TEST(Receiver, TheMapCoversTheShadowAndOneShadowSizeAround) {
   const GridSpec g = test_scenes::cubicGrid(10, 0.5);
   ReceiverSpec spec;

@@ -59,6 +59,10 @@ struct SimulationOptions {
   DepositMode deposit = DepositMode::Accumulate;
   DepositKernel deposit_kernel = DepositKernel::Track;
   std::optional<ReceiverSpec> receiver;  // the plane that stops the light and gets a map
+  // A directional light's light that meets the receiver's map without meeting the box is put on
+  // the map in closed form (directMapLight, receiver.h) instead of as patches that go straight
+  // to it; the map is the same to rounding. Off: every such cell is a patch (the tests' reference).
+  bool direct_receiver_light = true;
   // Fresnel reflections at sharp interfaces followed as their own wavefronts (0: none; their flux
   // is counted as reflected).
   int bounces = 1;

@@ -435,7 +435,8 @@ bool rayHitsMap(const glm::dvec3& origin, const glm::dvec3& dir, const ReceiverM
 }
 
 std::vector<Patch> directionalPatches(const LightSpec& light, const GridSpec& grid, const VolumeSampler& sampler,
-                                      const SimulationOptions& options, const ReceiverMap* map) {
+                                      const SimulationOptions& options, const ReceiverMap* map, DirectCells* direct,
+                                      double* flux_ref) {
   const glm::dvec3 L = glm::normalize(light.direction);
   glm::dvec3 U, V;
   orthonormalBasis(L, U, V);
@@ -473,6 +474,10 @@ std::vector<Patch> directionalPatches(const LightSpec& light, const GridSpec& gr
   auto vAt = [&](int i) { return vmin + (vmax - vmin) * (static_cast<double>(i) / nv); };
   auto point = [&](double u, double v) { return u * U + v * V + t0 * L; };
 
+  // The cells that go straight to the map, when they are left to directMapLight, per row.
+  const bool leave_direct = direct != nullptr && map != nullptr;
+  std::vector<DirectCells> row_direct(leave_direct ? static_cast<std::size_t>(nv) : 0);
+  std::vector<double> row_ref(static_cast<std::size_t>(nv), 0.0);
   std::vector<std::vector<Patch>> rows(static_cast<std::size_t>(nv));
   parallelFor(0, nv, [&](std::int64_t iv64) {
     const int iv = static_cast<int>(iv64);
@@ -483,7 +488,17 @@ std::vector<Patch> directionalPatches(const LightSpec& light, const GridSpec& gr
       Patch p;
       // x₀ = (u₀, v₀), x₁ = (u₁, v₀), x₂ = (u₁, v₁), x₃ = (u₀, v₁): N along L.
       p.x = {point(u0, v0), point(u1, v0), point(u1, v1), point(u0, v1)};
-      if (!rayHitsBox(p.midpoint(), L, lo, hi) && !rayHitsMap(p.midpoint(), L, map, edge)) continue;
+      const bool box = rayHitsBox(p.midpoint(), L, lo, hi);
+      if (!box && !rayHitsMap(p.midpoint(), L, map, edge)) continue;
+      if (!box && leave_direct) {
+        const glm::dvec3 flux = light.power * p.area();  // Φ = E_L·A, as the patch would carry
+        DirectCells& d = row_direct[static_cast<std::size_t>(iv)];
+        ++d.cells;
+        d.flux += flux;
+        double& ref = row_ref[static_cast<std::size_t>(iv)];
+        ref = std::max(ref, std::max(flux.x, std::max(flux.y, flux.z)));
+        continue;
+      }
       for (int c = 0; c < 4; ++c) {
         p.medium[c] = sampler.materialAt(p.x[c]);
         p.w[c] = L * sampler.materialOptics(p.medium[c], p.x[c]).x;
@@ -495,6 +510,12 @@ std::vector<Patch> directionalPatches(const LightSpec& light, const GridSpec& gr
   });
   std::vector<Patch> patches;
   for (auto& row : rows) patches.insert(patches.end(), row.begin(), row.end());
+  for (const DirectCells& d : row_direct) {
+    direct->cells += d.cells;
+    direct->flux += d.flux;
+  }
+  if (flux_ref)
+    for (const double ref : row_ref) *flux_ref = std::max(*flux_ref, ref);
   return patches;
 }
 
@@ -561,14 +582,17 @@ void validateLight(const LightSpec& light) {
 }
 
 std::vector<Patch> initialPatches(const LightSpec& light, const GridSpec& grid, const VolumeSampler& sampler,
-                                  const SimulationOptions& options, double* flux_ref, const ReceiverMap* map) {
+                                  const SimulationOptions& options, double* flux_ref, const ReceiverMap* map,
+                                  DirectCells* direct) {
   validateLight(light);
   validateOptions(options);
-  std::vector<Patch> patches = light.type == LightSpec::Type::Directional
-                                   ? directionalPatches(light, grid, sampler, options, map)
-                                   : pointPatches(light, grid, sampler, options, map);
+  if (direct) *direct = DirectCells{};
+  double ref = 0.0;  // the left-out cells' (directionalPatches), then the patches'
+  std::vector<Patch> patches =
+      light.type == LightSpec::Type::Directional
+          ? directionalPatches(light, grid, sampler, options, map, options.direct_receiver_light ? direct : nullptr, &ref)
+          : pointPatches(light, grid, sampler, options, map);
   if (flux_ref) {
-    double ref = 0.0;
     for (const Patch& patch : patches) ref = std::max(ref, std::max(patch.flux.x, std::max(patch.flux.y, patch.flux.z)));
     *flux_ref = ref;
   }

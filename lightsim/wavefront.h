@@ -272,10 +272,17 @@ constexpr int kMaxCubeResolution = 2048;
 void validateLight(const LightSpec& light);
 
 // With a receiver map (receiver.h), the patches also cover the map wholly: those whose ray meets the
-// map but not the box go straight to it.
+// map but not the box go straight to it. With `direct` as well, for a directional light with
+// options.direct_receiver_light, those cells are left out of the list: their number and flux go to
+// *direct, and directMapLight (receiver.h) puts their light on the map (for a point light, and
+// otherwise, *direct stays empty and every cell is a patch). Φ_ref is over every cell either way.
+struct DirectCells {
+  std::uint64_t cells = 0;
+  glm::dvec3 flux{0.0};  // W, RGB
+};
 std::vector<Patch> initialPatches(const LightSpec& light, const GridSpec& grid, const VolumeSampler& sampler,
                                   const SimulationOptions& options, double* flux_ref,
-                                  const ReceiverMap* map = nullptr);
+                                  const ReceiverMap* map = nullptr, DirectCells* direct = nullptr);
 
 // ---------------------------------------------------------------------------------------------
 // Constants of a run.
