@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/parallel.h"
+
 namespace eik {
 
 namespace {
@@ -55,20 +57,27 @@ QuietMap::QuietMap(const GridSpec& grid, const std::vector<glm::vec4>& ior_grad,
   };
   std::vector<std::uint8_t> flag(static_cast<std::size_t>(bricks_.x) * bricks_.y * bricks_.z, 0);
   auto brick = [&](int x, int y, int z) -> std::uint8_t& { return brickFlag(flag, x, y, z); };
-  for (int z = 0; z < d.z; ++z)
-    for (int y = 0; y < d.y; ++y)
-      for (int x = 0; x < d.x; ++x) {
-        const Signature s = signature(grid.index(x, y, z));
-        if (s.noisy) brick(x, y, z) = 1;
-        const int nx[3] = {x + 1, x, x}, ny[3] = {y, y + 1, y}, nz[3] = {z, z, z + 1};
-        for (int a = 0; a < 3; ++a) {
-          if (nx[a] >= d.x || ny[a] >= d.y || nz[a] >= d.z) continue;
-          if (!(signature(grid.index(nx[a], ny[a], nz[a])) == s)) {
-            brick(x, y, z) = 1;
-            brick(nx[a], ny[a], nz[a]) = 1;
+  // By layers of bricks in parallel, each layer writing only its own bricks: a pair of voxels that
+  // differ across two layers is flagged by each layer on its side (the upper one compares its
+  // lowest voxels with those below).
+  parallelFor(0, bricks_.z, [&](std::int64_t layer) {
+    const int z0 = static_cast<int>(layer) * brick_, z1 = std::min(d.z, z0 + brick_);
+    for (int z = z0; z < z1; ++z)
+      for (int y = 0; y < d.y; ++y)
+        for (int x = 0; x < d.x; ++x) {
+          const Signature s = signature(grid.index(x, y, z));
+          if (s.noisy) brick(x, y, z) = 1;
+          const int nx[3] = {x + 1, x, x}, ny[3] = {y, y + 1, y}, nz[3] = {z, z, z + 1};
+          for (int a = 0; a < 3; ++a) {
+            if (nx[a] >= d.x || ny[a] >= d.y || nz[a] >= d.z) continue;
+            if (!(signature(grid.index(nx[a], ny[a], nz[a])) == s)) {
+              brick(x, y, z) = 1;
+              if (nz[a] < z1) brick(nx[a], ny[a], nz[a]) = 1;  // in this layer
+            }
           }
+          if (z == z0 && z > 0 && !(signature(grid.index(x, y, z - 1)) == s)) brick(x, y, z) = 1;
         }
-      }
+  });
   buildTable(flag);
 }
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <tuple>
 
 #include "lightsim/test_scenes.h"
 #include "lightsim/wavefront.h"
@@ -113,6 +114,78 @@ TEST(QuietMap, AbsorptionEdgesAreNotQuietAndUniformAbsorptionIs) {
 // From flagged voxels (VolumeSampler::absorberMap): a box is quiet exactly when no trilinear sample
 // in it takes a flagged voxel as one of its eight taps (taps floor(q − ½) and the next, at voxel
 // coordinate q; 8³ voxels of 1/8, so brick = voxel); an absorbing sphere's map is not quiet at it.
+// The noisy bricks of a sharp volume, made by layers of bricks in parallel, are exactly those a
+// plain scan finds: a brick is noisy when a voxel in it is noisy itself (a distance exactly 0 here)
+// or differs from a face neighbour (the other side of a sign change of a slot's distance, or of a
+// σa edge). 170 voxels on x make bricks of 2, so pairs of voxels that differ across two layers of
+// bricks (z) are met on both sides; the answer is read from the summed-area table, brick by brick.
+TEST(QuietMap, TheNoisyBricksAreThoseANoisyVoxelOrADifferingFaceNeighbourMakes) {
+  const GridSpec grid = boxGrid({170, 9, 23}, 0.01);
+  const std::size_t n = grid.count();
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  // Two slots: slot 0 negative inside a few random balls, slot 1 below a tilted plane; σa changes on
+  // one random voxel in 500; one distance in 300 is exactly 0.
+  struct Ball { glm::dvec3 c; double r; };
+  std::vector<Ball> balls;
+  for (int b = 0; b < 6; ++b) balls.push_back({{unit(rng) * 170, unit(rng) * 9, unit(rng) * 23}, 2.0 + 4.0 * unit(rng)});
+  std::vector<glm::vec4> ior_grad(n, glm::vec4(1.0f, 0.0f, 0.0f, 0.0f)), distances(n);
+  std::vector<glm::vec3> sigma(n, glm::vec3(0.0f));
+  for (int z = 0; z < 23; ++z)
+    for (int y = 0; y < 9; ++y)
+      for (int x = 0; x < 170; ++x) {
+        const std::size_t i = grid.index(x, y, z);
+        double d0 = 1.0;
+        for (const Ball& b : balls) d0 = std::min(d0, glm::length(glm::dvec3(x, y, z) - b.c) - b.r);
+        const double d1 = 0.3 * x + 0.5 * y - 1.7 * z + 5.0;
+        distances[i] = glm::vec4(static_cast<float>(d0), static_cast<float>(d1), 1.0f, 1.0f);
+        if (unit(rng) < 1.0 / 300.0) distances[i].x = 0.0f;
+        if (unit(rng) < 1.0 / 500.0) sigma[i] = glm::vec3(0.5f);
+      }
+  InterfaceTable table;
+  table.slots.resize(2);
+  table.band = 0.04;
+  const QuietMap map(grid, ior_grad, distances, table, sigma);
+  ASSERT_EQ(map.brickVoxels(), 2);
+  // The plain scan.
+  auto signature = [&](std::size_t i) {
+    return std::tuple<bool, bool, float>(distances[i].x < 0.0f, distances[i].y < 0.0f, sigma[i].x);
+  };
+  const glm::ivec3 bricks = map.bricks();
+  std::vector<std::uint8_t> noisy(static_cast<std::size_t>(bricks.x) * bricks.y * bricks.z, 0);
+  auto flag = [&](int x, int y, int z) { noisy[static_cast<std::size_t>(x / 2 + bricks.x * (y / 2 + bricks.y * (z / 2)))] = 1; };
+  for (int z = 0; z < 23; ++z)
+    for (int y = 0; y < 9; ++y)
+      for (int x = 0; x < 170; ++x) {
+        const std::size_t i = grid.index(x, y, z);
+        if (distances[i].x == 0.0f || distances[i].y == 0.0f) flag(x, y, z);
+        const int nx[6] = {x - 1, x + 1, x, x, x, x}, ny[6] = {y, y, y - 1, y + 1, y, y}, nz[6] = {z, z, z, z, z - 1, z + 1};
+        for (int a = 0; a < 6; ++a) {
+          if (nx[a] < 0 || ny[a] < 0 || nz[a] < 0 || nx[a] >= 170 || ny[a] >= 9 || nz[a] >= 23) continue;
+          if (signature(grid.index(nx[a], ny[a], nz[a])) != signature(i)) flag(x, y, z);
+        }
+      }
+  // The table's count in each single brick.
+  const std::vector<std::uint32_t>& sat = map.table();
+  auto at = [&](int i, int j, int k) {
+    return static_cast<std::int64_t>(sat[static_cast<std::size_t>(i) + static_cast<std::size_t>(bricks.x + 1) *
+                                          (static_cast<std::size_t>(j) + static_cast<std::size_t>(bricks.y + 1) * static_cast<std::size_t>(k))]);
+  };
+  int checked_noisy = 0;
+  for (int k = 0; k < bricks.z; ++k)
+    for (int j = 0; j < bricks.y; ++j)
+      for (int i = 0; i < bricks.x; ++i) {
+        const std::int64_t count = at(i + 1, j + 1, k + 1) - at(i, j + 1, k + 1) - at(i + 1, j, k + 1) - at(i + 1, j + 1, k) +
+                                   at(i, j, k + 1) + at(i, j + 1, k) + at(i + 1, j, k) - at(i, j, k);
+        const bool expected = noisy[static_cast<std::size_t>(i + bricks.x * (j + bricks.y * k))] != 0;
+        ASSERT_EQ(count, expected ? 1 : 0) << "brick " << i << " " << j << " " << k;
+        checked_noisy += expected ? 1 : 0;
+      }
+  EXPECT_EQ(static_cast<std::size_t>(checked_noisy), map.noisyBricks());
+  EXPECT_GT(checked_noisy, 100);
+  EXPECT_LT(static_cast<std::size_t>(checked_noisy), noisy.size() / 2);
+}
+
 TEST(QuietMap, FlaggedVoxelsMakeTheBoxesWhoseSamplesTouchThemNoisy) {
   const GridSpec grid = cubicGrid(8, 0.5);  // [−0.5, 0.5]³, voxel edge 1/8
   std::vector<std::uint8_t> flags(grid.count(), 0);

@@ -117,25 +117,47 @@ VolumeSampler::VolumeSampler(const Volume& volume) : grid_(volume.grid), h_(voxe
   const Field& ior = volume.require("ior", 1);
   const Field& grad = volume.require("ior_grad", 3);
   const std::size_t n = grid_.count();
+  // The copies below, in chunks of voxels in parallel.
+  constexpr std::int64_t kChunk = 1 << 16;
+  const std::int64_t chunks = static_cast<std::int64_t>((n + kChunk - 1) / kChunk);
+  auto forChunks = [&](auto&& body) {
+    parallelFor(0, chunks, [&](std::int64_t c) {
+      const std::size_t begin = static_cast<std::size_t>(c * kChunk);
+      body(begin, std::min(n, begin + static_cast<std::size_t>(kChunk)));
+    });
+  };
   ior_grad_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const float* g = grad.voxel(i);
-    ior_grad_[i] = glm::vec4(ior.data[i], g[0], g[1], g[2]);
-  }
+  forChunks([&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const float* g = grad.voxel(i);
+      ior_grad_[i] = glm::vec4(ior.data[i], g[0], g[1], g[2]);
+    }
+  });
   table_ = interfaceTable(volume);
   if (!table_.empty()) {
     const Field& d = volume.require("interfaces", 4);
     distances_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) distances_[i] = glm::vec4(d.voxel(i)[0], d.voxel(i)[1], d.voxel(i)[2], d.voxel(i)[3]);
     const int used = slotCount();
-    bool unused_constant = true;
     unused_distance_ = used < 4 ? d.voxel(0)[used] : 0.0f;
-    for (std::size_t i = 0; i < n && unused_constant; ++i)
-      for (int k = used; k < 4; ++k) unused_constant = unused_constant && d.voxel(i)[k] == unused_distance_;
+    std::vector<std::uint8_t> chunk_constant(static_cast<std::size_t>(chunks), 1);
+    forChunks([&](std::size_t begin, std::size_t end) {
+      bool constant = true;
+      for (std::size_t i = begin; i < end; ++i) {
+        const float* v = d.voxel(i);
+        distances_[i] = glm::vec4(v[0], v[1], v[2], v[3]);
+        for (int k = used; k < 4; ++k) constant = constant && v[k] == unused_distance_;
+      }
+      chunk_constant[begin / static_cast<std::size_t>(kChunk)] = constant ? 1 : 0;
+    });
+    const bool unused_constant =
+        std::all_of(chunk_constant.begin(), chunk_constant.end(), [](std::uint8_t c) { return c != 0; });
     if (unused_constant && used < 4) {
       used_distances_.resize(n * static_cast<std::size_t>(used));
-      for (std::size_t i = 0; i < n; ++i)
-        for (int k = 0; k < used; ++k) used_distances_[i * static_cast<std::size_t>(used) + static_cast<std::size_t>(k)] = d.voxel(i)[k];
+      forChunks([&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+          for (int k = 0; k < used; ++k)
+            used_distances_[i * static_cast<std::size_t>(used) + static_cast<std::size_t>(k)] = d.voxel(i)[k];
+      });
     }
     // Each cell's material where its eight taps agree (materialAt).
     const glm::ivec3 dims = grid_.dims;
