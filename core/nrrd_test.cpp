@@ -370,6 +370,25 @@ TEST(NrrdMalformed, UnsupportedEncoding) {
   }
 }
 
+// Fields are checked in blocks of values: a bad value deep in a large field (past the first
+// blocks) is found and named where it is, and a field whose only bad value is its last is refused.
+TEST(NrrdMalformed, BadSamplesDeepInALargeFieldAreFoundWhereTheyAre) {
+  TempDir dir;
+  const std::string header = "NRRD0004\ntype: float\ndimension: 3\nsizes: 50 40 3\nendian: little\nencoding: raw\n\n";
+  std::vector<float> values(6000, 1.0f);
+  values[4321] = std::numeric_limits<float>::infinity();  // voxel (21, 6, 2): 4321 = 21 + 50·(6 + 40·2)
+  values[5000] = std::numeric_limits<float>::quiet_NaN();
+  writeFile(dir / "inf.nrrd", header + floatBytes(values));
+  expectRejected(dir / "inf.nrrd", "data", "at voxel (21, 6, 2)");
+  values.assign(6000, 1.0f);
+  values[5999] = 2e-40f;  // subnormal, the last value: voxel (49, 39, 2)
+  writeFile(dir / "tiny.nrrd", header + floatBytes(values));
+  expectRejected(dir / "tiny.nrrd", "data", "subnormal value 2e-40 at voxel (49, 39, 2)");
+  values[5999] = 1.0f;
+  writeFile(dir / "good.nrrd", header + floatBytes(values));
+  EXPECT_EQ(readNrrd(dir / "good.nrrd").data, values);
+}
+
 TEST(NrrdMalformed, NonFiniteSamples) {
   TempDir dir;
   std::vector<float> values = ramp(24);
