@@ -445,6 +445,39 @@ void stageNrrd(AtomicFileSet& files, const fs::path& path, const NrrdHeader& hea
   out.close();
 }
 
+bool stageNrrdCopy(AtomicFileSet& files, const fs::path& path, const NrrdHeader& header, const fs::path& source,
+                   const NrrdWriteOptions& options) {
+  if (options.detached) return false;
+  FilePtr in(std::fopen(source.c_str(), "rb"));
+  if (!in) return false;
+  ParsedHeader parsed;
+  try {
+    parsed = nrrd::parseHeader(source, in.get());  // leaves `in` at the samples of an attached file
+  } catch (const InputError&) {
+    return false;
+  }
+  const Encoding wanted = options.gzip ? Encoding::Gzip : Encoding::Raw;
+  if (!parsed.attached || parsed.line_skip != 0 || parsed.byte_skip != 0 || parsed.encoding != wanted ||
+      parsed.big_endian != (std::endian::native == std::endian::big) || parsed.header.sizes != header.sizes ||
+      parsed.header.components != header.components)
+    return false;
+  const std::string text = headerText(header, options, "");
+  OutputFile out(files.stage(path), path);
+  out.write(text.data(), text.size());
+  out.write("\n", 1);  // the blank line that ends an attached header
+  std::vector<char> buffer(std::size_t{1} << 20);
+  for (;;) {
+    const std::size_t n = std::fread(buffer.data(), 1, buffer.size(), in.get());
+    out.write(buffer.data(), n);
+    if (n < buffer.size()) {
+      if (std::ferror(in.get())) throw RuntimeError(source.string() + ": read failed: " + std::strerror(errno));
+      break;
+    }
+  }
+  out.close();
+  return true;
+}
+
 void writeNrrd(const fs::path& path, const NrrdImage& image, const NrrdWriteOptions& options) {
   AtomicFileSet files;
   stageNrrd(files, path, image.header(), image.data, options);

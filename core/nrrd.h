@@ -75,6 +75,15 @@ void writeNrrd(const std::filesystem::path& path, const NrrdImage& image, const 
 void stageNrrd(AtomicFileSet& files, const std::filesystem::path& path, const NrrdHeader& header,
                std::span<const float> data, const NrrdWriteOptions& options = {});
 
+// stageNrrd for data that is exactly what the attached NRRD `source` holds (read from it and not
+// changed since): the header is written as stageNrrd writes it and the encoded samples are copied
+// from `source` byte for byte, not encoded again. Only when `source` is attached, has no line or
+// byte skip, holds the header's sizes and components in this machine's byte order, and is encoded
+// as `options` asks (gzip or raw, attached); otherwise, or when it cannot be opened or parsed,
+// nothing is staged and false is returned (the caller then stages the data itself).
+bool stageNrrdCopy(AtomicFileSet& files, const std::filesystem::path& path, const NrrdHeader& header,
+                   const std::filesystem::path& source, const NrrdWriteOptions& options = {});
+
 // Name of the data file a detached write of `path` produces ("NAME.raw" or "NAME.raw.gz").
 std::filesystem::path detachedDataPath(const std::filesystem::path& path, bool gzip);
 

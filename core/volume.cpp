@@ -249,6 +249,7 @@ class ManifestReader {
         }
       }
       field.data = std::move(data[k]);
+      volume.field_files[entries[k].name] = entries[k].file;
     }
 
     readReceivers(root, volume, with_data);
@@ -611,7 +612,15 @@ std::string writeVolume(const Volume& volume, const fs::path& manifest, const Vo
                          " (docs/volume-format.md)");
     }
     const fs::path file = dir / (prefix + field_name + extension);
-    stage(file, nrrdHeaderFor(grid, field.components), field.data);
+    NrrdHeader header = nrrdHeaderFor(grid, field.components);
+    const auto unchanged = options.unchanged_fields.find(field_name);
+    header.generation = generation;
+    if (unchanged != options.unchanged_fields.end() && field.data.size() == header.valueCount() &&
+        stageNrrdCopy(files, file, header, unchanged->second, {options.gzip, options.detached})) {
+      written.push_back(file);
+    } else {
+      stage(file, header, field.data);
+    }
     table[field_name] = {{"file", file.filename().string()}, {"components", field.components}};
   }
 

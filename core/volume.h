@@ -46,6 +46,8 @@ struct Volume {
   // Further manifest entries carried through unchanged: "light", "bake_stats", "materials",
   // "source", ... (everything but the reserved keys written by writeVolume).
   nlohmann::json metadata = nlohmann::json::object();
+  // The NRRD file each field was read from (readVolume), for VolumeWriteOptions::unchanged_fields.
+  std::map<std::string, std::filesystem::path> field_files;
 
   // Adds (or replaces) a zero-filled field.
   Field& addField(const std::string& name, int components);
@@ -58,6 +60,11 @@ struct Volume {
 struct VolumeWriteOptions {
   bool gzip = true;         // NRRD encoding: gzip (default) or raw
   bool detached = false;    // .nhdr + .raw(.gz) instead of attached .nrrd
+  // Fields whose data is exactly that of the NRRD file given (Volume::field_files of a volume read
+  // and not changed since): its encoded samples are copied (stageNrrdCopy), not encoded again; a
+  // file that is gone or encoded otherwise is written from the data as usual. `lightsim` passes the
+  // input's fields it does not bake.
+  std::map<std::string, std::filesystem::path> unchanged_fields;
 };
 
 // Reads a manifest and every field it names. Throws InputError (exit 2) naming the file and the

@@ -229,6 +229,11 @@ int run(int argc, char** argv) {
   if (smooth_irradiance > 0.0) volume.metadata["irradiance_smoothing_sigma_voxels"] = smooth_irradiance;
   VolumeWriteOptions write;
   write.gzip = !raw;
+  // The input's fields are written back as they were read (their encoded samples copied), all but
+  // the two a bake makes.
+  write.unchanged_fields = volume.field_files;
+  write.unchanged_fields.erase("irradiance");
+  write.unchanged_fields.erase("light_dir");
   writeVolume(volume, output, write);
   if (!stats_path.empty()) writeFileAtomic(stats_path, stats_json.dump(2) + "\n");
   if (!quiet) {
