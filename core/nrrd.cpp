@@ -218,9 +218,9 @@ std::size_t firstBad(std::span<const float> values, Bad bad) {
   constexpr std::size_t kBlock = 1024;
   for (std::size_t begin = 0; begin < values.size(); begin += kBlock) {
     const std::size_t end = std::min(values.size(), begin + kBlock);
-    bool any = false;
-    for (std::size_t i = begin; i < end; ++i) any |= bad(std::bit_cast<std::uint32_t>(values[i]));
-    if (!any) continue;
+    unsigned any = 0;
+    for (std::size_t i = begin; i < end; ++i) any |= bad(std::bit_cast<std::uint32_t>(values[i])) ? 1u : 0u;
+    if (any == 0) continue;
     for (std::size_t i = begin; i < end; ++i)
       if (bad(std::bit_cast<std::uint32_t>(values[i]))) return i;
   }
@@ -236,7 +236,7 @@ std::size_t firstNonFinite(std::span<const float> values) {
 // values.size(). Fields never hold them (the writer flushes them to 0); in a file they are the
 // sign of bytes read in the wrong order (n = 1.5 byte-swapped reads as 4.6·10⁻⁴¹).
 std::size_t firstSubnormal(std::span<const float> values) {
-  return firstBad(values, [](std::uint32_t bits) { return (bits & 0x7F800000u) == 0u && (bits & 0x007FFFFFu) != 0u; });
+  return firstBad(values, [](std::uint32_t bits) { return ((bits & 0x7F800000u) == 0u) & ((bits & 0x007FFFFFu) != 0u); });
 }
 
 // "voxel (x, y, z)" and " component c" of a value index.

@@ -5,34 +5,51 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "core/parallel.h"
 
 namespace eik {
 
 bool activeRegion(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi) {
   const GridSpec& grid = volume.grid;
   const glm::ivec3 dims = grid.dims;
-  glm::ivec3 imin(dims), imax(-1);
-  auto mark = [&](std::size_t index) {
-    const int x = static_cast<int>(index % static_cast<std::size_t>(dims.x));
-    const int y = static_cast<int>((index / static_cast<std::size_t>(dims.x)) % static_cast<std::size_t>(dims.y));
-    const int z = static_cast<int>(index / (static_cast<std::size_t>(dims.x) * static_cast<std::size_t>(dims.y)));
-    imin = glm::min(imin, glm::ivec3(x, y, z));
-    imax = glm::max(imax, glm::ivec3(x, y, z));
-  };
-  const std::size_t count = grid.count();
   const double h = std::min({grid.voxelSize().x, grid.voxelSize().y, grid.voxelSize().z});
-  auto scan = [&](const char* name, auto&& nontrivial) {
-    const Field* f = volume.find(name);
-    if (!f) return;
-    for (std::size_t i = 0; i < count; ++i)
-      if (nontrivial(f->voxel(i))) mark(i);
+  const Field* ior = volume.find("ior");
+  const Field* grad = volume.find("ior_grad");
+  const Field* sigma = volume.find("sigma_a");
+  const Field* emission = volume.find("emission");
+  const Field* scatter = volume.find("scatter");
+  const Field* opaque = volume.find("opaque");
+  auto nontrivial = [&](std::size_t i) {
+    auto positive3 = [&](const Field* f) { return f && (f->voxel(i)[0] > 0 || f->voxel(i)[1] > 0 || f->voxel(i)[2] > 0); };
+    if (ior && std::abs(ior->voxel(i)[0] - 1.0f) > 1e-5f) return true;
+    if (grad) {
+      const float* v = grad->voxel(i);
+      if ((std::abs(v[0]) + std::abs(v[1]) + std::abs(v[2])) * h > 1e-6) return true;
+    }
+    return positive3(sigma) || positive3(emission) || (scatter && scatter->voxel(i)[0] > 0) ||
+           (opaque && opaque->voxel(i)[3] > 0);
   };
-  scan("ior", [](const float* v) { return std::abs(v[0] - 1.0f) > 1e-5f; });
-  scan("ior_grad", [&](const float* v) { return (std::abs(v[0]) + std::abs(v[1]) + std::abs(v[2])) * h > 1e-6; });
-  scan("sigma_a", [](const float* v) { return v[0] > 0 || v[1] > 0 || v[2] > 0; });
-  scan("emission", [](const float* v) { return v[0] > 0 || v[1] > 0 || v[2] > 0; });
-  scan("scatter", [](const float* v) { return v[0] > 0; });
-  scan("opaque", [](const float* v) { return v[3] > 0; });
+  // Each z-slice's extent in parallel, then theirs together.
+  std::vector<glm::ivec3> slice_min(static_cast<std::size_t>(dims.z), dims), slice_max(static_cast<std::size_t>(dims.z), glm::ivec3(-1));
+  parallelFor(0, dims.z, [&](std::int64_t z64) {
+    const int z = static_cast<int>(z64);
+    glm::ivec3& smin = slice_min[static_cast<std::size_t>(z)];
+    glm::ivec3& smax = slice_max[static_cast<std::size_t>(z)];
+    for (int y = 0; y < dims.y; ++y)
+      for (int x = 0; x < dims.x; ++x)
+        if (nontrivial(grid.index(x, y, z))) {
+          smin = glm::min(smin, glm::ivec3(x, y, z));
+          smax = glm::max(smax, glm::ivec3(x, y, z));
+        }
+  });
+  glm::ivec3 imin(dims), imax(-1);
+  for (int z = 0; z < dims.z; ++z) {
+    imin = glm::min(imin, slice_min[static_cast<std::size_t>(z)]);
+    imax = glm::max(imax, slice_max[static_cast<std::size_t>(z)]);
+  }
   if (imax.x < 0) return false;
   const glm::dvec3 voxel = grid.voxelSize();
   lo = glm::max(grid.bounds_min, grid.bounds_min + glm::dvec3(imin - 1) * voxel);
@@ -53,16 +70,21 @@ std::vector<float> homogeneousBricks(const Volume& volume, glm::ivec3& brick_dim
   const Field* opaque = volume.find("opaque");
   // Per voxel: does it break homogeneity by itself (∇n, emission, scattering, opaque)?
   std::vector<unsigned char> busy(grid.count(), 0);
-  for (std::size_t i = 0; i < grid.count(); ++i) {
-    const float* g = grad->voxel(i);
-    bool b = (std::abs(g[0]) + std::abs(g[1]) + std::abs(g[2])) * h > 1e-4;
-    if (emission) b = b || emission->voxel(i)[0] > 0 || emission->voxel(i)[1] > 0 || emission->voxel(i)[2] > 0;
-    if (scatter) b = b || scatter->voxel(i)[0] > 0;
-    if (opaque) b = b || opaque->voxel(i)[3] > 0;
-    busy[i] = b;
-  }
+  parallelFor(
+      0, static_cast<std::int64_t>(grid.count()),
+      [&](std::int64_t i64) {
+        const std::size_t i = static_cast<std::size_t>(i64);
+        const float* g = grad->voxel(i);
+        bool b = (std::abs(g[0]) + std::abs(g[1]) + std::abs(g[2])) * h > 1e-4;
+        if (emission) b = b || emission->voxel(i)[0] > 0 || emission->voxel(i)[1] > 0 || emission->voxel(i)[2] > 0;
+        if (scatter) b = b || scatter->voxel(i)[0] > 0;
+        if (opaque) b = b || opaque->voxel(i)[3] > 0;
+        busy[i] = b;
+      },
+      1 << 15);
   std::vector<float> bricks(static_cast<std::size_t>(brick_dims.x) * brick_dims.y * brick_dims.z, 0.0f);
-  for (int bz = 0; bz < brick_dims.z; ++bz)
+  parallelFor(0, brick_dims.z, [&](std::int64_t bz64) {
+    const int bz = static_cast<int>(bz64);
     for (int by = 0; by < brick_dims.y; ++by)
       for (int bx = 0; bx < brick_dims.x; ++bx) {
         const glm::ivec3 lo = glm::max(glm::ivec3(bx, by, bz) * kBrickVoxels - kBrickMargin, glm::ivec3(0));
@@ -81,6 +103,7 @@ std::vector<float> homogeneousBricks(const Volume& volume, glm::ivec3& brick_dim
             }
         bricks[(static_cast<std::size_t>(bz) * brick_dims.y + by) * brick_dims.x + bx] = homogeneous ? 1.0f : 0.0f;
       }
+  });
   return bricks;
 }
 
