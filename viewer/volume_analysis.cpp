@@ -12,16 +12,25 @@
 
 namespace eik {
 
+namespace {
+
+// The fields the analyses read (null where the volume has none).
+struct MediumFields {
+  const Field *ior, *grad, *sigma, *emission, *scatter, *opaque;
+  explicit MediumFields(const Volume& v)
+      : ior(v.find("ior")), grad(v.find("ior_grad")), sigma(v.find("sigma_a")), emission(v.find("emission")),
+        scatter(v.find("scatter")), opaque(v.find("opaque")) {}
+};
+
+}  // namespace
+
 bool activeRegion(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi) {
   const GridSpec& grid = volume.grid;
   const glm::ivec3 dims = grid.dims;
   const double h = std::min({grid.voxelSize().x, grid.voxelSize().y, grid.voxelSize().z});
-  const Field* ior = volume.find("ior");
-  const Field* grad = volume.find("ior_grad");
-  const Field* sigma = volume.find("sigma_a");
-  const Field* emission = volume.find("emission");
-  const Field* scatter = volume.find("scatter");
-  const Field* opaque = volume.find("opaque");
+  const MediumFields f(volume);
+  const Field *ior = f.ior, *grad = f.grad, *sigma = f.sigma, *emission = f.emission, *scatter = f.scatter,
+              *opaque = f.opaque;
   auto nontrivial = [&](std::size_t i) {
     auto positive3 = [&](const Field* f) { return f && (f->voxel(i)[0] > 0 || f->voxel(i)[1] > 0 || f->voxel(i)[2] > 0); };
     if (ior && std::abs(ior->voxel(i)[0] - 1.0f) > 1e-5f) return true;
@@ -62,12 +71,9 @@ std::vector<float> homogeneousBricks(const Volume& volume, glm::ivec3& brick_dim
   const glm::ivec3 dims = grid.dims;
   brick_dims = (dims + kBrickVoxels - 1) / kBrickVoxels;
   const double h = std::min({grid.voxelSize().x, grid.voxelSize().y, grid.voxelSize().z});
-  const Field* ior = volume.find("ior");
-  const Field* grad = volume.find("ior_grad");
-  const Field* sigma = volume.find("sigma_a");
-  const Field* emission = volume.find("emission");
-  const Field* scatter = volume.find("scatter");
-  const Field* opaque = volume.find("opaque");
+  const MediumFields f(volume);
+  const Field *ior = f.ior, *grad = f.grad, *sigma = f.sigma, *emission = f.emission, *scatter = f.scatter,
+              *opaque = f.opaque;
   // Per voxel: does it break homogeneity by itself (∇n, emission, scattering, opaque)?
   std::vector<unsigned char> busy(grid.count(), 0);
   parallelFor(
