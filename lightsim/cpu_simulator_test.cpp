@@ -569,6 +569,14 @@ TEST(CpuSimulator, SameBitsWhateverTheThreadCount) {
     SimulationOptions o;
     o.max_depth = 5;  // fewer patches, same machinery
     o.free_flight = flight;
+    if (flight) {
+      // A floor with its map beyond the sphere's shadow: footprints by bands of rows, and the
+      // direct light in closed form (directMapLight), also by bands.
+      ReceiverSpec floor;
+      floor.point = {0.0, -0.7, 0.0};
+      floor.half_extent = 1.5;
+      o.receiver = floor;
+    }
     return sim.run(light, o);
   };
   const BakeResult one = bake(1), two = bake(2), three = bake(3);
@@ -584,7 +592,13 @@ TEST(CpuSimulator, SameBitsWhateverTheThreadCount) {
     EXPECT_EQ(one.stats.total_patches, other->stats.total_patches);
     EXPECT_EQ(one.stats.splits, other->stats.splits);
     EXPECT_EQ(one.stats.flights, other->stats.flights);
+    ASSERT_EQ(one.receivers.size(), other->receivers.size());
+    if (!one.receivers.empty()) {
+      EXPECT_EQ(one.receivers[0].irradiance, other->receivers[0].irradiance);
+    }
+    EXPECT_EQ(one.stats.flux_received, other->stats.flux_received);
   }
+  EXPECT_EQ(one.receivers.size(), flight ? 1u : 0u);
   EXPECT_GT(one.stats.splits, 0u);
   }
 }
