@@ -2,14 +2,13 @@
 
 #include <gtest/gtest.h>
 
-#include <zlib.h>
-
 #include <cstdint>
 #include <string>
 #include <utility>
 
 #include "core/error.h"
 #include "core/image_io.h"
+#include "core/image_test_bytes.h"
 #include "core/testing.h"
 
 namespace eik {
@@ -18,6 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 using test_support::TempDir;
 using test_support::writeFile;
+using namespace test_support::png;
 
 // OpenEXR's layout, built byte by byte (independent of OpenEXR: what a hostile file would hold).
 std::string int32(std::int64_t v) {
@@ -53,7 +53,7 @@ void expectRefusedBy(Check check, const fs::path& path, const std::string& bytes
   }
 }
 
-// An image of one value, for OpenImageIO to write as the formats' own libraries do.
+// An image of one value, written by the formats' own libraries (writeImage).
 Image flatImage(int width, int height, int channels, float value) {
   Image image;
   image.width = width;
@@ -172,25 +172,7 @@ TEST(ExrHeader, TruncatedOrForeignFilesAreRefused) {
   expectRefused(dir.path(), kMagic, "version: the file ends inside the header");
 }
 
-// PNG's layout: chunks of a big-endian length, a type, the data and a CRC (the walk leaves the CRC
-// to libpng, so these carry zeros).
-std::string bigEndian(std::uint32_t v) {
-  return std::string{static_cast<char>(v >> 24), static_cast<char>(v >> 16 & 0xff), static_cast<char>(v >> 8 & 0xff),
-                     static_cast<char>(v & 0xff)};
-}
-std::string chunk(const std::string& type, const std::string& data) { return bigEndian(static_cast<std::uint32_t>(data.size())) + type + data + std::string(4, '\0'); }
-const std::string kPngSignature = "\x89PNG\r\n\x1a\n";
 const std::string kIhdr = chunk("IHDR", bigEndian(4) + bigEndian(4) + std::string{8, 2, 0, 0, 0});
-
-std::string deflated(const std::string& data) {
-  uLongf size = compressBound(static_cast<uLong>(data.size()));
-  std::string out(size, '\0');
-  if (compress(reinterpret_cast<Bytef*>(out.data()), &size, reinterpret_cast<const Bytef*>(data.data()),
-               static_cast<uLong>(data.size())) != Z_OK)
-    throw std::runtime_error("compress failed");
-  out.resize(size);
-  return out;
-}
 
 void expectPngRefused(const fs::path& dir, const std::string& bytes, const std::string& expected) {
   expectRefusedBy([](const fs::path& p) { checkPngChunks(p); }, dir / "map.png", bytes, expected);

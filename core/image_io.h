@@ -1,5 +1,6 @@
-// Images in and out through OpenImageIO: renders as EXR (linear, untone-mapped float) or PNG
-// (tone-mapped 8-bit sRGB), environment maps in (EXR, HDR, PNG, ...). Writes are atomic.
+// Images in and out: renders as EXR (linear, untone-mapped half float, OpenEXR) or PNG (tone-mapped
+// 8-bit sRGB, libpng), environment maps in (OpenEXR, PNG, Radiance .hdr through stb_image). Writes
+// are atomic.
 #pragma once
 
 #include <filesystem>
@@ -25,8 +26,9 @@ struct ImageWriteOptions {
   ToneMapper tonemap = ToneMapper::Aces;  // PNG only
 };
 
-// By extension: .exr writes linear half-float RGB(A) as rendered; .png (also .jpg, .tif) writes
-// tone-mapped sRGB 8-bit. InputError for an unknown extension, RuntimeError when writing fails.
+// By extension: .exr writes linear half-float RGB(A) as rendered (one channel as Y), zip-compressed;
+// .png writes tone-mapped sRGB 8-bit RGB. InputError for any other extension, RuntimeError when
+// writing fails.
 void writeImage(const std::filesystem::path& path, const Image& image, const ImageWriteOptions& options = {});
 
 // The largest image readImage accepts, per axis (an environment map must fit GL_MAX_TEXTURE_SIZE,
@@ -34,7 +36,8 @@ void writeImage(const std::filesystem::path& path, const Image& image, const Ima
 constexpr int kMaxImageAxis = 16384;
 
 // Reads .exr, .hdr or .png, with the reader the extension names and no other, as linear float
-// RGB(A) (sRGB-encoded 8/16-bit PNGs are linearised). InputError naming the file when it
+// RGB(A) (8/16-bit PNGs are taken as sRGB and linearised, unless a gAMA chunk of 1 says linear;
+// an OpenEXR file's R, G, B (A) channels, else Y (A), else its first four; a .hdr's RGBE as RGB). InputError naming the file when it
 // cannot be read, when its header claims more than kMaxImageAxis pixels an axis or more memory
 // than the machine has (core/limits.h), both checked before a pixel is allocated, when its OpenEXR
 // header or PNG chunks fail the walks of core/image_headers.h (before their libraries read them),

@@ -1,5 +1,5 @@
 // libFuzzer harness: image headers and pixels (core/image_io.h readImage), the environment maps the
-// viewer reads (OpenImageIO parses; our checks run before any pixel). The input's magic picks the
+// viewer reads (OpenEXR, libpng or stb_image parse; our checks run before any pixel). The input's magic picks the
 // name, and so the reader (readImage takes the extension's reader only): OpenEXR's "v/1\x01" → .exr,
 // PNG's "\x89PNG" → .png, anything else → Radiance .hdr. The seeds hold all three.
 #include <cstring>

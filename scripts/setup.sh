@@ -7,7 +7,8 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config git
   libosmesa6-dev libegl-dev libegl-mesa0 libgl1-mesa-dri
-  libglfw3-dev libglm-dev libopenimageio-dev openimageio-tools libtinygltf-dev python3-glad
+  libglfw3-dev libglm-dev libopenexr-dev libpng-dev libstb-dev libtinygltf-dev python3-glad
+  openimageio-tools  # scripts: oiiotool converts the HDRIs (fetch_assets.sh) and the gallery's PNGs
   nlohmann-json3-dev libcli11-dev zlib1g-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libimgui-dev

@@ -140,7 +140,7 @@ TEST(ViewerCli, BadInputExitsTwo) {
 // NRRD so declared took 9.4 s and 4.15 GiB before it was refused): refused with exit 2 before its
 // 4 GiB (ior) and 12 GiB (ior_grad) are allocated. The bound is on what reading adds to the
 // program's own peak memory (its `--help` run: the libraries alone, 56 MB for lightsim with Mesa's,
-// 180 MB for the viewer with OpenImageIO's): under 50 MB. Sanitizer builds reserve memory of their
+// about as much for the viewer): under 50 MB. Sanitizer builds reserve memory of their
 // own, so the bound is checked without them.
 TEST(ViewerCli, A1024CubedVolumeInTinyFilesIsRefusedBeforeItsMemory) {
   TempDir dir;

@@ -3,7 +3,7 @@
 // Kinds (docs/scene-format.md "environment"):
 //   uniform      {"uniform": [r, g, b]}
 //   map          {"file": "sky.exr", "intensity": 1, "rotate_deg": 0}: an equirectangular
-//                (latitude/longitude) HDR/EXR/PNG, read through OpenImageIO and mipmapped; rays
+//                (latitude/longitude) HDR/EXR/PNG, read by core/image_io and mipmapped; rays
 //                that diverged through glass look it up at a coarser level (footprint LOD)
 //   sky          {"procedural": "sky"}: an analytic daylight sky, brighter towards the horizon and
 //                the sun (the scene's first directional light), over a dim ground-coloured lower half
