@@ -98,7 +98,7 @@ void QuietMap::chooseBricks() {
   const int longest = std::max(d.x, std::max(d.y, d.z));
   brick_ = longest <= 160 ? 1 : longest <= 512 ? 2 : 4;
   brick_shift_ = brick_ == 1 ? 0 : brick_ == 2 ? 1 : 2;
-  voxel_size_ = grid_.voxelSize();
+  inv_voxel_size_ = 1.0 / grid_.voxelSize();
   bricks_ = (d + (brick_ - 1)) / brick_;
 }
 
@@ -165,7 +165,7 @@ void QuietMap::buildTable(const std::vector<std::uint8_t>& flag) {
 bool QuietMap::quiet(const glm::dvec3& lo, const glm::dvec3& hi) const {
   if (sat_.empty()) return false;
   int b0[3], b1[3];
-  const glm::dvec3 qlo = (lo - grid_.bounds_min) / voxel_size_, qhi = (hi - grid_.bounds_min) / voxel_size_;  // toVoxel
+  const glm::dvec3 qlo = (lo - grid_.bounds_min) * inv_voxel_size_, qhi = (hi - grid_.bounds_min) * inv_voxel_size_;  // toVoxel
   for (int a = 0; a < 3; ++a) {
     if (!std::isfinite(qlo[a]) || !std::isfinite(qhi[a])) return false;
     // The taps of a sample at voxel coordinate q (centres at i + ½): floor(c) and floor(c) + 1 with

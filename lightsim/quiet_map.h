@@ -57,7 +57,7 @@ class QuietMap {
 
  private:
   GridSpec grid_;
-  glm::dvec3 voxel_size_{1.0};  // grid_.voxelSize(), once (quiet divides by it, as toVoxel does)
+  glm::dvec3 inv_voxel_size_{1.0};  // 1/grid_.voxelSize(), once (quiet multiplies by it: toVoxel)
   int brick_ = 2;
   int brick_shift_ = 1;  // log₂ brick_
   glm::ivec3 bricks_{0};

@@ -32,9 +32,10 @@ inline AxisTap clampedTap(double c, int n) {
   return {i0, i1, c - static_cast<double>(i0)};
 }
 
-inline AxisTap axisTap(double world, double lo, double extent, int n) {
-  // uvw = (x − min)/extent, c = uvw·dims − 0.5 (ALGORITHM.md "Units and inputs").
-  double c = (world - lo) / extent * static_cast<double>(n) - 0.5;
+inline AxisTap axisTap(double world, double lo, double scale, int n) {
+  // uvw = (x − min)/extent, c = uvw·dims − 0.5 (ALGORITHM.md "Units and inputs"); scale = dims/extent,
+  // a multiplication where a division cost 4 % of a bake.
+  double c = (world - lo) * scale - 0.5;
   return clampedTap(c, n);
 }
 
@@ -42,9 +43,12 @@ struct Taps3 {
   AxisTap x, y, z;
 };
 
-inline Taps3 taps3(const GridSpec& g, const glm::dvec3& p, const glm::dvec3& extent) {
-  return {axisTap(p.x, g.bounds_min.x, extent.x, g.dims.x), axisTap(p.y, g.bounds_min.y, extent.y, g.dims.y),
-          axisTap(p.z, g.bounds_min.z, extent.z, g.dims.z)};
+// dims/extent per axis: voxel coordinates per world unit.
+inline glm::dvec3 tapScale(const GridSpec& g) { return glm::dvec3(g.dims) / g.extent(); }
+
+inline Taps3 taps3(const GridSpec& g, const glm::dvec3& p, const glm::dvec3& scale) {
+  return {axisTap(p.x, g.bounds_min.x, scale.x, g.dims.x), axisTap(p.y, g.bounds_min.y, scale.y, g.dims.y),
+          axisTap(p.z, g.bounds_min.z, scale.z, g.dims.z)};
 }
 
 // Σ weight·at(index) over the eight taps, for any Out with Out*double and Out+Out (double, glm
@@ -92,7 +96,7 @@ double voxelEdge(const GridSpec& grid) {
 }
 
 TrilinearTaps trilinearTaps(const GridSpec& grid, const glm::dvec3& world) {
-  const Taps3 t = taps3(grid, world, grid.extent());
+  const Taps3 t = taps3(grid, world, tapScale(grid));
   TrilinearTaps out;
   for (int k = 0; k < 8; ++k) {
     const int kx = k & 1, ky = (k >> 1) & 1, kz = (k >> 2) & 1;
@@ -113,7 +117,8 @@ glm::dvec4 sampleTrilinear(const Field& field, const GridSpec& grid, const glm::
   return out;
 }
 
-VolumeSampler::VolumeSampler(const Volume& volume) : grid_(volume.grid), h_(voxelEdge(volume.grid)) {
+VolumeSampler::VolumeSampler(const Volume& volume)
+    : grid_(volume.grid), h_(voxelEdge(volume.grid)), tap_scale_(tapScale(volume.grid)) {
   const Field& ior = volume.require("ior", 1);
   const Field& grad = volume.require("ior_grad", 3);
   const std::size_t n = grid_.count();
@@ -197,19 +202,19 @@ double VolumeSampler::ior(const glm::dvec3& world) const { return iorAndGradient
 
 glm::dvec4 VolumeSampler::iorAndGradient(const glm::dvec3& world) const {
   if (sharp()) return materialOptics(materialAt(world), world);
-  return interpolate<glm::dvec4>(ior_grad_, grid_, taps3(grid_, world, grid_.extent()));
+  return interpolate<glm::dvec4>(ior_grad_, grid_, taps3(grid_, world, tap_scale_));
 }
 
 int VolumeSampler::materialAt(const glm::dvec3& world) const {
   if (!sharp()) return -1;
-  const Taps3 t = taps3(grid_, world, grid_.extent());
+  const Taps3 t = taps3(grid_, world, tap_scale_);
   const std::int8_t cell = cell_material_[grid_.index(t.x.i0, t.y.i0, t.z.i0)];
   return cell != kMixedCell ? cell : materialSlot(distances(world), slotCount());
 }
 
 glm::dvec4 VolumeSampler::distances(const glm::dvec3& world) const {
   if (distances_.empty()) return glm::dvec4(0.0);
-  const Taps3 taps = taps3(grid_, world, grid_.extent());
+  const Taps3 taps = taps3(grid_, world, tap_scale_);
   switch (used_distances_.empty() ? 4 : slotCount()) {
     case 1: return interpolateUsed<1>(used_distances_, unused_distance_, grid_, taps);
     case 2: return interpolateUsed<2>(used_distances_, unused_distance_, grid_, taps);
@@ -223,7 +228,7 @@ glm::dvec4 VolumeSampler::materialOptics(int slot, const glm::dvec3& world) cons
   if (slot < 0) return {1.0, 0.0, 0.0, 0.0};
   const InterfaceSlot& s = table_.slots[static_cast<std::size_t>(slot)];
   if (!s.graded) return {s.ior, 0.0, 0.0, 0.0};
-  return interpolate<glm::dvec4>(ior_grad_, grid_, taps3(grid_, world, grid_.extent()));
+  return interpolate<glm::dvec4>(ior_grad_, grid_, taps3(grid_, world, tap_scale_));
 }
 
 QuietMap VolumeSampler::quietMap() const { return QuietMap(grid_, ior_grad_, distances_, table_, sigma_a_); }
@@ -247,12 +252,27 @@ double VolumeSampler::minIor() const {
 }
 
 glm::dvec3 VolumeSampler::interfaceNormal(int slot, const glm::dvec3& world) const {
+  if (distances_.empty()) return glm::dvec3(0.0);
+  // Slot `slot`'s distance from a lookup's taps, as distances() interpolates it.
+  const int used = used_distances_.empty() ? 4 : slotCount();
+  auto distance = [&](const Taps3& t) {
+    if (used == 4) return blendTaps<double>(grid_, t, [&](std::size_t i) { return static_cast<double>(distances_[i][slot]); });
+    return blendTaps<double>(grid_, t, [&](std::size_t i) {
+      return static_cast<double>(used_distances_[i * static_cast<std::size_t>(used) + static_cast<std::size_t>(slot)]);
+    });
+  };
+  // Central differences half a voxel either side on each axis: the offset axis' taps are the only
+  // ones that change, the others are the point's own.
   const glm::dvec3 h = 0.5 * grid_.voxelSize();
+  const Taps3 mid = taps3(grid_, world, tap_scale_);
   glm::dvec3 g;
   for (int a = 0; a < 3; ++a) {
-    glm::dvec3 e(0.0);
-    e[a] = h[a];
-    g[a] = (distances(world + e)[slot] - distances(world - e)[slot]) / (2.0 * h[a]);
+    Taps3 plus = mid, minus = mid;
+    AxisTap& p = a == 0 ? plus.x : a == 1 ? plus.y : plus.z;
+    AxisTap& m = a == 0 ? minus.x : a == 1 ? minus.y : minus.z;
+    p = axisTap(world[a] + h[a], grid_.bounds_min[a], tap_scale_[a], grid_.dims[a]);
+    m = axisTap(world[a] - h[a], grid_.bounds_min[a], tap_scale_[a], grid_.dims[a]);
+    g[a] = (distance(plus) - distance(minus)) / (2.0 * h[a]);
   }
   const double len = glm::length(g);
   return len > 0.0 ? g / len : glm::dvec3(0.0);
@@ -260,7 +280,7 @@ glm::dvec3 VolumeSampler::interfaceNormal(int slot, const glm::dvec3& world) con
 
 glm::dvec3 VolumeSampler::sigmaA(const glm::dvec3& world) const {
   if (sigma_a_.empty()) return glm::dvec3(0.0);
-  return interpolate<glm::dvec3>(sigma_a_, grid_, taps3(grid_, world, grid_.extent()));
+  return interpolate<glm::dvec3>(sigma_a_, grid_, taps3(grid_, world, tap_scale_));
 }
 
 // ---------------------------------------------------------------------------------------------

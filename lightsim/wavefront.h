@@ -136,6 +136,7 @@ class VolumeSampler {
  private:
   GridSpec grid_;
   double h_ = 0.0;
+  glm::dvec3 tap_scale_{1.0};  // dims/extent: world to voxel coordinates (taps3)
   std::vector<glm::vec4> ior_grad_;  // (n, ∇n) per voxel
   std::vector<glm::vec3> sigma_a_;   // empty: no absorption
   InterfaceTable table_;
