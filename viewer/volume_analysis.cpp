@@ -47,12 +47,17 @@ bool activeRegion(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi) {
     const int z = static_cast<int>(z64);
     glm::ivec3& smin = slice_min[static_cast<std::size_t>(z)];
     glm::ivec3& smax = slice_max[static_cast<std::size_t>(z)];
-    for (int y = 0; y < dims.y; ++y)
-      for (int x = 0; x < dims.x; ++x)
-        if (nontrivial(grid.index(x, y, z))) {
-          smin = glm::min(smin, glm::ivec3(x, y, z));
-          smax = glm::max(smax, glm::ivec3(x, y, z));
-        }
+    for (int y = 0; y < dims.y; ++y) {
+      // A row's extent from its two ends: its first and last non-trivial voxels (its inside, an
+      // object's interior, needs no look).
+      int first = 0;
+      while (first < dims.x && !nontrivial(grid.index(first, y, z))) ++first;
+      if (first == dims.x) continue;
+      int last = dims.x - 1;
+      while (!nontrivial(grid.index(last, y, z))) --last;
+      smin = glm::min(smin, glm::ivec3(first, y, z));
+      smax = glm::max(smax, glm::ivec3(last, y, z));
+    }
   });
   glm::ivec3 imin(dims), imax(-1);
   for (int z = 0; z < dims.z; ++z) {
