@@ -202,11 +202,10 @@ class PngReader {
 
   // Reads every row into `rows` (height × rowBytes()); false on an error.
   bool readRows(unsigned char* rows) {
+    row_pointers_.resize(height_);
+    for (png_uint_32 y = 0; y < height_; ++y) row_pointers_[y] = rows + static_cast<std::size_t>(y) * row_bytes_;
     if (setjmp(png_jmpbuf(png_))) return false;
-    std::vector<png_bytep>* pointers = &row_pointers_;
-    pointers->resize(height_);
-    for (png_uint_32 y = 0; y < height_; ++y) (*pointers)[y] = rows + static_cast<std::size_t>(y) * row_bytes_;
-    png_read_image(png_, pointers->data());
+    png_read_image(png_, row_pointers_.data());
     png_read_end(png_, nullptr);
     return true;
   }
