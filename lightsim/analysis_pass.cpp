@@ -21,12 +21,12 @@ AnalysisPass::AnalysisPass(const gl::ShaderLibrary& library, DepositMode mode, c
   program_ = library.program("common/fullscreen.vert", "lightsim/analysis.frag", defines, volumeDefines);
 }
 
-void AnalysisPass::run(const PatchTextures& current, const PatchTextures& previous, std::size_t count,
-                       StepTargets& targets, const gl::VolumeTextures& volume, const GridUniforms& grid,
+void AnalysisPass::run(const PatchTextures& current, const PatchTextures& previous, const LiveCount& live,
+                       std::size_t slots, StepTargets& targets, const gl::VolumeTextures& volume, const GridUniforms& grid,
                        const StepUniforms& step) const {
   gl::ScopedPassBindings unbind;
   targets.framebuffer.bind();
-  viewportLiveBox(count);
+  viewportLiveBox(slots);
   program_.use();
   int unit = current.bind(program_, "uPatch", 0);  // 8 units
   for (int c = 0; c < 4; ++c, ++unit) {
@@ -35,9 +35,9 @@ void AnalysisPass::run(const PatchTextures& current, const PatchTextures& previo
   }
   previous.texture(PatchTextures::kFlux).bind(unit);
   program_.setSampler("uPreviousFlux", unit++);
-  volume.bind(program_, unit);  // at most 2 (optics, absorption): 15 of the 16 units GL 3.3 guarantees
+  unit = volume.bind(program_, unit);  // at most 2 (optics, absorption)
+  live.bind(program_, unit);           // 16 units in all, as many as GL 3.3 guarantees
   grid.set(program_);
-  program_.set("uCount", static_cast<int>(count));
   program_.set("uDt", step.dt);
   program_.set("uStepDt", step.stepDt);
   program_.set("uFluxKill", step.fluxKill);

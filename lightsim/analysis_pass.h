@@ -9,10 +9,10 @@
 //            keep; 2 or 4 split); 4: the voxel of the new midpoint and the value deposited there;
 //            2 and 3: the flux absorbed and reflected in this step, for the ledger
 //   in       list `current` (after the update pass) and `previous` (before it: m_old, Φ_old),
-//            patches 0 .. count − 1; the volume, GridUniforms and of StepUniforms Δt, the kill
+//            patches 0 .. n − 1 (n the LiveCount on the GPU; drawn over `slots` ≥ n); the volume, GridUniforms and of StepUniforms Δt, the kill
 //            threshold, split length, depth limit and split rule
-//   out      `targets`: counts (the pyramid's base), deposit A/B, ledger A/B; slots beyond count
-//            get count 0 and no deposit
+//   out      `targets`: counts (the pyramid's base), deposit A/B, ledger A/B; slots from n on
+//            (to the live box of `slots`) get count 0 and no deposit
 //
 // The CPU twin of one patch is stepPatch (cpu_simulator.h), steps 4 and 5.
 #pragma once
@@ -26,6 +26,7 @@
 #include "gl/volume_textures.h"
 #include "lightsim/atlas.h"
 #include "lightsim/grid_uniforms.h"
+#include "lightsim/live_count.h"
 #include "lightsim/patch_textures.h"
 #include "lightsim/simulator.h"
 #include "lightsim/step_targets.h"
@@ -40,8 +41,9 @@ class AnalysisPass {
   // the receiver plane of StepUniforms are received (RECEIVER).
   AnalysisPass(const gl::ShaderLibrary& library, DepositMode mode, const AtlasLayout& atlas,
                const std::string& volumeDefines, bool track = false, bool receiver = false);
-  void run(const PatchTextures& current, const PatchTextures& previous, std::size_t count, StepTargets& targets,
-           const gl::VolumeTextures& volume, const GridUniforms& grid, const StepUniforms& step) const;
+  void run(const PatchTextures& current, const PatchTextures& previous, const LiveCount& live, std::size_t slots,
+           StepTargets& targets, const gl::VolumeTextures& volume, const GridUniforms& grid,
+           const StepUniforms& step) const;
 
  private:
   gl::Program program_;

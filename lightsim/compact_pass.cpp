@@ -10,11 +10,11 @@ CompactPass::CompactPass(const gl::ShaderLibrary& library, const gl::ShaderDefin
                          const std::string& volumeDefines)
     : program_(library.program("common/fullscreen.vert", "lightsim/compact.frag", pyramidDefines, volumeDefines)) {}
 
-void CompactPass::run(const PatchTextures& in, const StepTargets& targets, PatchTextures& out, std::size_t total,
+void CompactPass::run(const PatchTextures& in, const StepTargets& targets, PatchTextures& out, std::size_t slots,
                       const gl::VolumeTextures& volume, const GridUniforms& grid, float dt) const {
   gl::ScopedPassBindings unbind;
   out.framebuffer().bind();
-  viewportLiveBox(total);
+  viewportLiveBox(slots);
   program_.use();
   int unit = in.bind(program_, "uPatch", 0);
   targets.pyramid.bind(unit);
@@ -23,7 +23,6 @@ void CompactPass::run(const PatchTextures& in, const StepTargets& targets, Patch
   program_.setSampler("uLedgerA", unit++);
   volume.bind(program_, unit);
   grid.set(program_);
-  program_.set("uTotal", static_cast<int>(total));
   program_.set("uDt", dt);
   triangle_.draw();
   gl::checkErrors("CompactPass");

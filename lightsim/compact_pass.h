@@ -8,8 +8,9 @@
 //            corners and w, w renormalised to n, flux shared by area, depth + 1 or + ½)
 //   in       list `in` (the updated list the analysis saw), `targets` (its built pyramid, and
 //            ledger A for the fate of each source), the volume (n at the new corners), GridUniforms
-//   out      list `out`: patches 0 .. total − 1, total = the pyramid's total (read back first, and
-//            at most out's capacity)
+//   out      list `out`: patches 0 .. total − 1, total = the pyramid's total (hpTotal, read on
+//            the GPU); `slots` (≥ total, ≤ out's capacity) sizes the draw: the total itself when it
+//            was read back, or a bound on it (4 × the list the analysis saw) when it was not
 //
 // The CPU twin is the prefix sum over the counts and splitPatch in CpuSimulator::run (the same
 // order: the pyramid's Morton order is the prefix sum's index order).
@@ -35,7 +36,7 @@ class CompactPass {
               const std::string& volumeDefines);
   // dt: an ordinary step's time, Δt or a straight step's (StepUniforms::stepDt): with sharp
   // interfaces the reach of a followed reflection, 4·dt + 2h (sharp.glsl reflectedPatch).
-  void run(const PatchTextures& in, const StepTargets& targets, PatchTextures& out, std::size_t total,
+  void run(const PatchTextures& in, const StepTargets& targets, PatchTextures& out, std::size_t slots,
            const gl::VolumeTextures& volume, const GridUniforms& grid, float dt = 0.0f) const;
 
  private:

@@ -67,8 +67,10 @@ struct DepositFixture {
     step.dt = dt;
     step.splitLength = 1.0f;
     step.maxDepth = 8.0f;
+    gpu::LiveCount live;
+    live.set(packed.size());
     gpu::AnalysisPass(library, mode, layout, textures.layout().glslDefines())
-        .run(list, list, packed.size(), targets, textures, grid, step);
+        .run(list, list, live, packed.size(), targets, textures, grid, step);
     AtlasTargets atlas(layout, mode);
     gpu::DepositPass(library, layout, mode).run(targets.depositA, targets.depositB, packed.size(), atlas, 1e-3f);
     atlas.toFields(irradiance, dir);

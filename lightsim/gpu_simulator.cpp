@@ -25,6 +25,7 @@
 #include "lightsim/histo_pyramid.h"
 #include "lightsim/ledger_pass.h"
 #include "lightsim/list_set.h"
+#include "lightsim/live_count.h"
 #include "lightsim/patch_textures.h"
 #include "lightsim/quiet_texture.h"
 #include "lightsim/receiver.h"
@@ -190,10 +191,17 @@ struct GpuSimulator::Impl {
       case GpuSimulatorOptions::Timing::Finish: return gl::PhaseTimer::Mode::Finish;
       case GpuSimulatorOptions::Timing::Auto: break;
     }
-    const std::string& r = gl::GlContext::current()->info().renderer;
-    const bool software = r.find("llvmpipe") != std::string::npos || r.find("softpipe") != std::string::npos ||
-                          r.find("swrast") != std::string::npos;
-    return software ? gl::PhaseTimer::Mode::Off : gl::PhaseTimer::Mode::Queries;
+    return gl::isSoftwareRenderer(gl::GlContext::current()->info()) ? gl::PhaseTimer::Mode::Off
+                                                                    : gl::PhaseTimer::Mode::Queries;
+  }
+  // GpuSimulatorOptions::count_readback, Auto resolved for the current renderer.
+  bool overlapCounts() const {
+    switch (config.count_readback) {
+      case GpuSimulatorOptions::CountReadback::Wait: return false;
+      case GpuSimulatorOptions::CountReadback::Overlap: return true;
+      case GpuSimulatorOptions::CountReadback::Auto: break;
+    }
+    return !gl::isSoftwareRenderer(gl::GlContext::current()->info());
   }
   gpu::TrackDepositPass& trackPassFor() {
     if (!trackPass) trackPass = std::make_unique<gpu::TrackDepositPass>(library, atlasLayout);
@@ -242,6 +250,8 @@ nlohmann::json GpuSimulator::lastRunStats() const {
                             {"atlas", info.atlas_bytes},
                             {"patch_lists_peak", info.patch_bytes_peak},
                             {"total_peak", info.texture_bytes_peak}};
+  stats["count_readback"] = {{"mode", info.overlapped_counts ? "overlap" : "wait"},
+                             {"steps_waited", info.waited_counts}};
   return stats;
 }
 
@@ -375,8 +385,6 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
 
   const int maxSteps = eik::maxSteps(grid, options);
   const double totalIn = luminance(stats.flux_in);
-  std::size_t count = initial.size();
-  stats.peak_patches = count;
   gl::PhaseTimer timer(timingMode(), stats.phase_seconds);
   auto report = [&] {
     ledger.flush();
@@ -391,76 +399,123 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     }
   };
 
-  for (int s = 0; s < maxSteps && count > 0; ++s) {
+  // The count of the live list stays on the GPU (live_count.h): each step's passes read it there
+  // and are drawn over `slots` ≥ it. `known` is the count when the CPU has it (`haveCount`); with
+  // Overlap the CPU collects a step's count after the next step's passes are queued
+  // (GpuSimulatorOptions::CountReadback).
+  const bool overlap = overlapCounts();
+  info.overlapped_counts = overlap;
+  gpu::LiveCount live;
+  live.set(initial.size());
+  std::size_t slots = initial.size();
+  std::uint64_t known = initial.size();
+  bool haveCount = true;
+  auto collect = [&] {
+    const Stopwatch readWatch;
+    const std::uint64_t n = live.wait();
+    stats.phase_seconds["readback"] += readWatch.seconds();
+    return n;
+  };
+  // A list set that holds `needed` slots, within max_patch_side and the texture budget; nullptr
+  // when none does (`s`: the step, for the error of a list that must grow and cannot).
+  auto listFor = [&](std::uint64_t needed, int s, bool mustFit) -> std::unique_ptr<gpu::ListSet> {
+    const std::uint64_t maxSlots = static_cast<std::uint64_t>(maxSide) * static_cast<std::uint64_t>(maxSide);
+    if (needed > maxSlots) {
+      if (!mustFit) return nullptr;
+      throw RuntimeError("GPU light simulator: step " + std::to_string(s + 1) + " needs " + std::to_string(needed) +
+                         " patches, over the patch list limit of " + std::to_string(maxSide) + "x" +
+                         std::to_string(maxSide) + " = " + std::to_string(maxSlots) +
+                         " (GpuSimulatorOptions::max_patch_side, GL_MAX_TEXTURE_SIZE); raise split_voxels or "
+                         "lower max_depth");
+    }
+    const int side = std::min(maxSide, patchSideFor(needed, lists->side() * 2));
+    const std::size_t budget = config.budget_bytes ? config.budget_bytes : gl::defaultTextureBudget();
+    const std::size_t bytes = info.volume_bytes + info.atlas_bytes + gpu::ListSet::bytesFor(lists->side()) +
+                              gpu::ListSet::bytesFor(side);  // the old set lives until the compaction
+    if (bytes > budget) {
+      if (!mustFit) return nullptr;
+      throw RuntimeError("GPU light simulator: step " + std::to_string(s + 1) + " needs " + std::to_string(needed) +
+                         " patches, a patch list of " + std::to_string(side) + "x" + std::to_string(side) +
+                         " that takes the texture memory to " + bytesText(bytes) + ", over the budget of " +
+                         bytesText(budget) + " (EIKONAL_GL_TEXTURE_BUDGET_MB); raise split_voxels or lower "
+                         "max_depth");
+    }
+    timer.start("grow");
+    auto grown = std::make_unique<gpu::ListSet>(side, library);
+    timer.stop();
+    return grown;
+  };
+
+  for (int s = 0; s < maxSteps && slots > 0; ++s) {
     if (options.cancel && options.cancel->load(std::memory_order_relaxed)) throw BakeCancelled();
-    stats.steps = s + 1;
-    stats.total_patches += count;
-    stats.peak_patches = std::max<std::uint64_t>(stats.peak_patches, count);  // live at a step's start
     gpu::ListSet& L = *lists;
 
     timer.start("update");
-    updatePass.run(L.a, L.b, count, volume, gridUniforms, step, maps);
+    updatePass.run(L.a, L.b, live, slots, volume, gridUniforms, step, maps);
     timer.start("analysis");
-    analysisPass.run(L.b, L.a, count, L.targets, volume, gridUniforms, step);
+    analysisPass.run(L.b, L.a, live, slots, L.targets, volume, gridUniforms, step);
     timer.start("deposit");
     if (!options.volume_deposits) {
       // only the receiver's map (below)
     } else if (track) {
-      trackPassFor().run(L.a, L.b, L.targets.depositA, count, atlas, trackUniforms);
+      trackPassFor().run(L.a, L.b, L.targets.depositA, slots, atlas, trackUniforms);
     } else {
-      depositPass.run(L.targets.depositA, L.targets.depositB, count, atlas, energyRef);
+      depositPass.run(L.targets.depositA, L.targets.depositB, slots, atlas, energyRef);
     }
     if (options.receiver) {
       timer.start("receiver");
-      receiverPassFor().run(L.b, L.targets.depositB, count, receiverTarget, receiver, origin);
+      receiverPassFor().run(L.b, L.targets.depositB, slots, receiverTarget, receiver, origin);
     }
     timer.start("ledger");
-    ledger.addStep(L.targets, L.b, count, extraLedger);
+    ledger.addStep(L.targets, L.b, slots, extraLedger);
     timer.start("pyramid");
-    L.targets.pyramid.build(count);
+    L.targets.pyramid.build(slots);  // the analysis wrote count 0 past the live patches
+    live.takeTotal(L.targets.pyramid);
     timer.stop();
-    const Stopwatch readWatch;
-    const std::uint64_t total = L.targets.pyramid.readTotal();
-    stats.phase_seconds["readback"] += readWatch.seconds();
 
-    if (total > L.a.capacity()) {
-      // Grow: a new pair of lists of the side that holds `total`; compaction writes the new list
-      // from the old updated list (nothing to copy), then the old set goes.
-      if (total > static_cast<std::uint64_t>(maxSide) * static_cast<std::uint64_t>(maxSide)) {
-        throw RuntimeError("GPU light simulator: step " + std::to_string(s + 1) + " needs " + std::to_string(total) +
-                           " patches, over the patch list limit of " + std::to_string(maxSide) + "x" +
-                           std::to_string(maxSide) + " = " + std::to_string(maxSide * maxSide) +
-                           " (GpuSimulatorOptions::max_patch_side, GL_MAX_TEXTURE_SIZE); raise split_voxels or "
-                           "lower max_depth");
-      }
-      const int side = std::min(maxSide, patchSideFor(total, L.side() * 2));
-      const std::size_t budget = config.budget_bytes ? config.budget_bytes : gl::defaultTextureBudget();
-      const std::size_t needed = info.volume_bytes + info.atlas_bytes + gpu::ListSet::bytesFor(L.side()) +
-                                 gpu::ListSet::bytesFor(side);  // the old set lives until the compaction
-      if (needed > budget) {
-        throw RuntimeError("GPU light simulator: step " + std::to_string(s + 1) + " needs " + std::to_string(total) +
-                           " patches, a patch list of " + std::to_string(side) + "x" + std::to_string(side) +
-                           " that takes the texture memory to " + bytesText(needed) + ", over the budget of " +
-                           bytesText(budget) + " (EIKONAL_GL_TEXTURE_BUDGET_MB); raise split_voxels or lower "
-                           "max_depth");
-      }
-      timer.start("grow");
-      auto grown = std::make_unique<gpu::ListSet>(side, library);
+    // This step's count: known, or collected now that its passes are queued behind the read.
+    if (!haveCount) known = collect();
+    haveCount = true;
+    const std::uint64_t count = known;
+    if (count == 0) break;  // the step did nothing
+    stats.steps = s + 1;
+    stats.total_patches += count;
+    stats.peak_patches = std::max<std::uint64_t>(stats.peak_patches, count);  // live at a step's start
+
+    live.request();  // the new count
+    std::unique_ptr<gpu::ListSet> grown;
+    const std::uint64_t bound = std::uint64_t{GpuSimulatorOptions::kMaxChildren} * count;
+    if (overlap && bound <= L.a.capacity()) {
+      haveCount = false;
+      slots = bound;
+    } else if (overlap && (grown = listFor(bound, s, false))) {
+      haveCount = false;
+      slots = bound;
+    } else {
+      ++info.waited_counts;
+      known = collect();
+      slots = known;
+      if (slots > L.a.capacity()) grown = listFor(slots, s, true);
+    }
+    if (slots > 0) {
+      // Compaction writes the new list (into a grown set's: nothing to copy; the old set goes).
       timer.start("compact");
-      compact(L.targets.pyramid).run(L.b, L.targets, grown->a, total, volume, gridUniforms, step.stepDt);
-      timer.stop();
-      lists = std::move(grown);
-      info.peak_patch_side = std::max(info.peak_patch_side, lists->side());
-    } else if (total > 0) {
-      timer.start("compact");
-      compact(L.targets.pyramid).run(L.b, L.targets, L.a, total, volume, gridUniforms, step.stepDt);
+      compact(L.targets.pyramid).run(L.b, L.targets, grown ? grown->a : L.a, slots, volume, gridUniforms, step.stepDt);
       timer.stop();
     }
-    count = static_cast<std::size_t>(total);
+    if (grown) {
+      lists = std::move(grown);
+      info.peak_patch_side = std::max(info.peak_patch_side, lists->side());
+    }
     if (ledger.full()) report();
   }
-  const std::size_t unfinished_at_end = count;
-  if (count > 0) ledger.addUnfinished(lists->a, count);
+  if (!haveCount) {
+    ++info.waited_counts;
+    known = collect();
+  }
+  // The list left when the steps ran out (0 when the light is done).
+  const auto unfinished_at_end = static_cast<std::size_t>(known);
+  if (unfinished_at_end > 0) ledger.addUnfinished(lists->a, unfinished_at_end);
   report();
   timer.collect(true);
 

@@ -32,7 +32,8 @@
 // budget; a run that would exceed them stops with a RuntimeError naming the step, the size and the
 // limit.
 //
-// The only readback per step is the pyramid's total (one texel). The energy ledger (flux absorbed,
+// The only readback per step is the pyramid's total (one texel), and with CountReadback::Overlap
+// the CPU collects it a step late, so it never stalls the GPU. The energy ledger (flux absorbed,
 // reflected, exited, killed per reason, counts, splits) is summed on the GPU into one row per step
 // and read back every ledger_interval steps, where it is summed in double (so float sums never run
 // over more than one step); the progress callback is called then. Phases are timed with
@@ -67,6 +68,23 @@ struct GpuSimulatorOptions {
   //            where queries cut the work into small flushes (measured: 15–40 % slower bakes).
   enum class Timing { Auto, Off, Queries, Finish };
   Timing timing = Timing::Auto;
+  // When the CPU learns each step's new patch count (the pyramid's total; ALGORITHM.md "The count
+  // stays on the GPU"). The passes read the count on the GPU (live_count.h) either way:
+  //   Wait     read back after the step's pyramid is built, before its compaction is queued: every
+  //            pass is drawn over exactly the live patches, but the GPU runs dry while the CPU
+  //            waits for the texel and queues the next passes;
+  //   Overlap  read back one step later, after the compaction and the next step's passes are
+  //            queued: those are drawn over a bound, kMaxChildren × the last count known, and skip
+  //            the slots past the count on the GPU; the lists are sized for the bound (up to
+  //            kMaxChildren × the memory). A step whose bound would exceed max_patch_side or the
+  //            texture budget waits as in Wait;
+  //   Auto     Overlap on a hardware GPU, Wait on a software rasteriser (llvmpipe, softpipe,
+  //            swrast), which shades every fragment of the bound in full and has no GPU to keep busy.
+  // The bake is the same in every mode, to the bit (GpuSimulatorTest.OverlappedCountReadback...).
+  enum class CountReadback { Auto, Wait, Overlap };
+  CountReadback count_readback = CountReadback::Auto;
+  // The most slots one patch takes in the next list: a 2×2 split and a followed reflection.
+  static constexpr int kMaxChildren = 5;
   // Sample n, ∇n and σa with trilinear interpolation done in the shader (8 texelFetch a lookup,
   // float weights) instead of the texture units' filtering, whose weights GPUs quantise (8 bits of
   // sub-texel position on NVIDIA). Agrees with the CPU twin to float rounding; slower on GPUs.
@@ -88,6 +106,10 @@ struct GpuRunInfo {
   std::size_t atlas_bytes = 0;
   std::size_t patch_bytes_peak = 0;   // both lists, count/fate targets and pyramid, at the peak size
   std::size_t texture_bytes_peak = 0; // all of the above together
+  bool overlapped_counts = false;     // CountReadback resolved to Overlap
+  int waited_counts = 0;              // steps whose new count the CPU waited for before queuing on
+                                      // (every step with Wait; with Overlap only where the bound did
+                                      // not fit, and the last)
   double wall_seconds = 0.0;
 };
 

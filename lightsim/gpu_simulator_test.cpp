@@ -241,6 +241,75 @@ struct TiltedSphereOverAFloor {
   }
 };
 
+// The count read back a step late (GpuSimulatorOptions::CountReadback::Overlap, what a hardware
+// GPU gets): the passes are drawn over kMaxChildren × the last count known and skip the slots past
+// the count on the GPU, so the bake must be the one of Wait to the bit — fields, receiver map and
+// every ledger entry — with the CPU waiting for no step's count (it collects each while the next
+// step's passes are queued), but the list left when the steps run out. Three runs: the
+// sharp sphere over its floor (splits, followed reflections, receiver, track deposits, the list
+// growing), the same stopped after 40 steps (the list left unfinished), and with a list limit the
+// bound does not fit, where steps fall back to waiting and the bake is still the same.
+TEST(GpuSimulatorTest, OverlappedCountReadbackBakesWhatWaitingForEveryCountDoes) {
+  const TiltedSphereOverAFloor scene;
+  test_scenes::glContext();
+  SimulationOptions full = scene.options, stopped = scene.options;
+  stopped.max_steps = 40;
+  struct Case {
+    const char* name;
+    SimulationOptions options;
+    int maxSide;
+  };
+  for (const Case& run : {Case{"full", full, 2048}, Case{"stopped", stopped, 2048}, Case{"tight", full, 0}}) {
+    SCOPED_TRACE(run.name);
+    GpuSimulatorOptions wait, overlap;
+    wait.count_readback = GpuSimulatorOptions::CountReadback::Wait;
+    overlap.count_readback = GpuSimulatorOptions::CountReadback::Overlap;
+    GpuSimulator waiting(scene.volume, wait);
+    const BakeResult w = waiting.run(scene.light, run.options);
+    const GpuRunInfo wInfo = waiting.lastRunInfo();
+    // "tight": the smallest list side that holds the peak the waiting run needed.
+    overlap.max_patch_side = run.maxSide > 0 ? run.maxSide : wInfo.peak_patch_side;
+    GpuSimulator overlapping(scene.volume, overlap);
+    const BakeResult o = overlapping.run(scene.light, run.options);
+    const GpuRunInfo oInfo = overlapping.lastRunInfo();
+    std::printf("%s: %d steps, %llu patch-steps, peak %llu; waited for %d counts (wait) and %d (overlap); list side "
+                "%d and %d\n",
+                run.name, w.stats.steps, static_cast<unsigned long long>(w.stats.total_patches),
+                static_cast<unsigned long long>(w.stats.peak_patches), wInfo.waited_counts, oInfo.waited_counts,
+                wInfo.peak_patch_side, oInfo.peak_patch_side);
+    EXPECT_FALSE(wInfo.overlapped_counts);
+    EXPECT_TRUE(oInfo.overlapped_counts);
+    ASSERT_GT(w.stats.splits, 0u);
+    ASSERT_GT(w.stats.reflections, 0u);
+    EXPECT_GT(w.stats.steps, 8);
+    EXPECT_EQ(wInfo.waited_counts, w.stats.steps);
+    if (run.maxSide > 0) {
+      EXPECT_EQ(oInfo.waited_counts, run.options.max_steps > 0 ? 1 : 0);  // the list left unfinished
+      EXPECT_GE(oInfo.peak_patch_side, wInfo.peak_patch_side);
+    } else {
+      EXPECT_GT(oInfo.waited_counts, 1);                 // the bound did not fit
+      EXPECT_LT(oInfo.waited_counts, wInfo.waited_counts);  // but mostly it did
+    }
+    if (run.options.max_steps > 0) EXPECT_GT(luminance(w.stats.flux_unfinished), 0.0);
+    EXPECT_EQ(o.irradiance.data, w.irradiance.data);
+    EXPECT_EQ(o.light_dir.data, w.light_dir.data);
+    ASSERT_EQ(o.receivers.size(), 1u);
+    EXPECT_EQ(o.receivers[0].irradiance, w.receivers.at(0).irradiance);
+    EXPECT_EQ(o.stats.steps, w.stats.steps);
+    EXPECT_EQ(o.stats.total_patches, w.stats.total_patches);
+    EXPECT_EQ(o.stats.peak_patches, w.stats.peak_patches);
+    EXPECT_EQ(o.stats.splits, w.stats.splits);
+    EXPECT_EQ(o.stats.reflections, w.stats.reflections);
+    EXPECT_EQ(o.stats.kills.trapped, w.stats.kills.trapped);
+    EXPECT_EQ(o.stats.flux_out, w.stats.flux_out);
+    EXPECT_EQ(o.stats.flux_absorbed, w.stats.flux_absorbed);
+    EXPECT_EQ(o.stats.flux_reflected, w.stats.flux_reflected);
+    EXPECT_EQ(o.stats.flux_received, w.stats.flux_received);
+    EXPECT_EQ(o.stats.flux_unfinished, w.stats.flux_unfinished);
+    EXPECT_LT(o.stats.ledgerResidual(), 1e-5);
+  }
+}
+
 // Free flight with volume deposits (lightsim's default for a scattering or opaque object): the
 // GPU path flies only as far as its track deposit pass reaches (flight.glsl flightFits), the twin
 // as far as the quiet space goes; both flights are exact for track deposits, so the bakes agree

@@ -135,8 +135,7 @@ void HistoPyramid::reduceLevels(GLuint counts, std::size_t liveSlots) {
   gl::checkErrors("HistoPyramid::build");
 }
 
-namespace {
-std::uint64_t totalFromTop(const float top[4]) {
+std::uint64_t hpTotalOfTop(const float top[4]) {
   std::uint64_t total = 0;
   for (int i = 0; i < 4; ++i) {
     if (!(top[i] >= 0.0f) || !std::isfinite(top[i])) {
@@ -147,7 +146,6 @@ std::uint64_t totalFromTop(const float top[4]) {
   }
   return total;
 }
-}  // namespace
 
 std::uint64_t HistoPyramid::readTotal() const {
   gl::detail::ScopedBinding read(GL_READ_FRAMEBUFFER, GL_READ_FRAMEBUFFER_BINDING, gl::detail::bindFramebuffer,
@@ -157,7 +155,7 @@ std::uint64_t HistoPyramid::readTotal() const {
   float top[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
   glReadPixels(0, 0, 1, 1, GL_RGBA, GL_FLOAT, top);
   gl::checkErrors("HistoPyramid::readTotal");
-  return totalFromTop(top);
+  return hpTotalOfTop(top);
 }
 
 void HistoPyramid::requestTotal() {
@@ -176,7 +174,18 @@ std::uint64_t HistoPyramid::waitTotal() {
   if (!pending_) requestTotal();
   pending_ = false;
   const std::vector<float> top = pbo_.download<float>(4);
-  return totalFromTop(top.data());
+  return hpTotalOfTop(top.data());
+}
+
+void HistoPyramid::copyTopTo(const gl::Texture2D& target) const {
+  if (target.format() != gl::TextureFormat::RGBA32F) {
+    throw std::logic_error("HistoPyramid::copyTopTo: the target must be RGBA32F");
+  }
+  gl::detail::ScopedBinding read(GL_READ_FRAMEBUFFER, GL_READ_FRAMEBUFFER_BINDING, gl::detail::bindFramebuffer,
+                                 framebuffers_.back().get());
+  gl::detail::ScopedBinding binding(GL_TEXTURE_2D, GL_TEXTURE_BINDING_2D, gl::detail::bindTexture, target.id());
+  glCopyTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, 0, 0, 1, 1);
+  gl::checkErrors("HistoPyramid::copyTopTo");
 }
 
 void HistoPyramid::bind(int unit) const { pyramid_.bind(unit); }

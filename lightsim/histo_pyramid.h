@@ -81,6 +81,9 @@ inline glm::ivec2 hpLiveBox(std::uint64_t count) { return mortonBox(count); }
 int hpBaseSizeFor(std::uint64_t capacity);
 // log2 of a base side that is a power of two in [1, kMaxBaseSize]; InputError otherwise.
 int hpCheckedLevels(int baseSize);
+// The total a top texel (or a copy of it) holds: the sum of its four components; RuntimeError
+// when one is not a non-negative finite number.
+std::uint64_t hpTotalOfTop(const float top[4]);
 
 // ---------------------------------------------------------------------------------------------
 // GPU pyramid (needs a current GL context for its whole life; destroy it before the context).
@@ -116,6 +119,9 @@ class HistoPyramid {
   // more work in between.
   void requestTotal();
   std::uint64_t waitTotal();
+  // Copies the top texel into texel (0, 0) of `target` (an RGBA32F texture; a GPU copy, no wait):
+  // how the simulator keeps the count on the GPU (live_count.h).
+  void copyTopTo(const gl::Texture2D& target) const;
 
   // Binds the pyramid texture (all its mip levels) to unit `unit` for hpFind/hpTotal (leaves that
   // unit active). Its filter is GL_NEAREST_MIPMAP_NEAREST; read it with texelFetch only.

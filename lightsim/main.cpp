@@ -32,7 +32,8 @@ namespace {
 int run(int argc, char** argv) {
   std::string input, output, light_text, power_text = "1,1,1", scene_path, backend = "auto", deposit = "accumulate",
                                          integrator = "euler", split_rule = "axis", at_max_depth = "keep", stats_path,
-                                         gl_backend = "auto", kernel = "track", receiver_text;
+                                         gl_backend = "auto", kernel = "track", receiver_text,
+                                         count_readback = "auto";
   bool no_receiver = false;
   SimulationOptions options;
   double options_receiver_pitch = 0.25;
@@ -124,6 +125,11 @@ int run(int argc, char** argv) {
                  "kill patches below this fraction of the initial patch flux (default 1e-4)")
       ->check(CLI::Range(0.0, 1.0));
   app.add_option("--gl", gl_backend, "OpenGL back end for --backend gl: auto | osmesa | egl (default auto)");
+  app.add_option("--count-readback", count_readback,
+                 "--backend gl: when the CPU reads each step's patch count: overlap (a step late, the passes "
+                 "drawn over a bound, so the GPU never waits), wait (every step, exact draws) or auto (default: "
+                 "overlap on a hardware GPU, wait on a software rasteriser); the bake is the same")
+      ->check(CLI::IsMember({"auto", "wait", "overlap"}));
   app.add_option("--stats", stats_path, "write steps, patches, splits, kills, flux ledger and phase times as JSON");
   app.add_option("--bench", bench_runs,
                  "bake N times and print the median wall time, patch-steps per second, peak patches and (gl) "
@@ -183,6 +189,9 @@ int run(int argc, char** argv) {
                    : backend == "auto" ? SimulatorBackend::Auto
                                        : SimulatorBackend::Gl;
   choice.gl = gl_backend;
+  choice.count_readback = count_readback == "wait"      ? GpuSimulatorOptions::CountReadback::Wait
+                          : count_readback == "overlap" ? GpuSimulatorOptions::CountReadback::Overlap
+                                                        : GpuSimulatorOptions::CountReadback::Auto;
   choice.source = input;
   if (!quiet)
     choice.report = [](const std::string& why) { std::fprintf(stderr, "lightsim: --backend auto: %s\n", why.c_str()); };

@@ -51,6 +51,7 @@ std::unique_ptr<Simulator> makeSimulator(const Volume& volume, const SimulatorBa
   GpuSimulatorOptions gpu;
   gpu.source = options.source;
   gpu.backend = gl::parseGlBackend(options.gl);
+  gpu.count_readback = options.count_readback;
   return std::make_unique<GpuSimulator>(volume, gpu, std::move(probe));
 }
 

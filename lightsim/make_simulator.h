@@ -13,6 +13,7 @@
 #include <string>
 
 #include "core/volume.h"
+#include "lightsim/gpu_simulator.h"
 #include "lightsim/simulator.h"
 
 namespace eik {
@@ -26,6 +27,8 @@ struct SimulatorBackendOptions {
   // for Auto, a reason to take the CPU twin.
   std::string gl = "auto";
   std::string source = "volume";  // the manifest, for error messages (GpuSimulatorOptions::source)
+  // Gl: when the CPU reads each step's patch count (`--count-readback`; GpuSimulatorOptions).
+  GpuSimulatorOptions::CountReadback count_readback = GpuSimulatorOptions::CountReadback::Auto;
   // Auto only: told which back end was chosen and why, e.g. "llvmpipe (LLVM 15.0.6, 256 bits), so
   // the CPU twin (faster than a software rasterizer)" or "no OpenGL context (...), so the CPU twin".
   std::function<void(const std::string&)> report;

@@ -25,6 +25,7 @@
 #include "lightsim/atlas.h"
 #include "lightsim/cpu_simulator.h"
 #include "lightsim/grid_uniforms.h"
+#include "lightsim/live_count.h"
 #include "lightsim/patch_textures.h"
 #include "lightsim/step_targets.h"
 #include "lightsim/step_uniforms.h"
@@ -242,8 +243,10 @@ struct MidFlightList {
 
 // The GPU passes of one step on a MidFlightList's patches, set up as GpuSimulator does it (but in
 // world coordinates): the volume uploaded, the run's uniforms, the list uploaded into `a` (of a
-// side that holds `capacity` patches, and at least the list), `b` and the step targets. update()
-// and analyse() run those passes in the simulator's order (a → b, then b with a as the list before).
+// side that holds `capacity` patches, and at least the list), `b` and the step targets, and its
+// count into a LiveCount. update() and analyse() run those passes in the simulator's order (a → b,
+// then b with a as the list before), drawn over `slots` (the count, unless a test sets more: the
+// bound of GpuSimulatorOptions::CountReadback::Overlap).
 struct GpuStep {
   gl::GlContext& gl = glContext();  // first: everything below needs it current
   gl::ShaderLibrary library;
@@ -253,8 +256,10 @@ struct GpuStep {
   gpu::GridUniforms grid;
   gpu::StepUniforms step;
   std::size_t count;
+  std::size_t slots;
   PatchTextures a, b;
   gpu::StepTargets targets;
+  gpu::LiveCount live;
 
   explicit GpuStep(const MidFlightList& list, std::size_t capacity = 0)
       : textures(list.volume),
@@ -263,19 +268,21 @@ struct GpuStep {
         grid(gpu::GridUniforms::from(list.volume.grid)),
         step(gpu::StepUniforms::from(list.volume.grid, list.options, list.fluxRef)),
         count(list.patches.size()),
+        slots(count),
         a(patchSideFor(std::max(count, capacity))),
         b(a.side()),
         targets(a.side(), library) {
     std::vector<PatchTexels> packed;
     for (const Patch& p : list.patches) packed.push_back(packPatch(p));
     a.upload(packed);
+    live.set(count);
   }
 
   void update(Integrator integrator) {
-    gpu::UpdatePass(library, integrator, defines).run(a, b, count, textures, grid, step);
+    gpu::UpdatePass(library, integrator, defines).run(a, b, live, slots, textures, grid, step);
   }
   void analyse(DepositMode mode) {
-    gpu::AnalysisPass(library, mode, atlas, defines).run(b, a, count, targets, textures, grid, step);
+    gpu::AnalysisPass(library, mode, atlas, defines).run(b, a, live, slots, targets, textures, grid, step);
   }
 };
 

@@ -35,19 +35,20 @@ UpdatePass::UpdatePass(const gl::ShaderLibrary& library, Integrator integrator, 
       freeFlight_(freeFlight),
       absorberMap_(absorberMap) {}
 
-void UpdatePass::run(const PatchTextures& in, PatchTextures& out, std::size_t count, const gl::VolumeTextures& volume,
-                     const GridUniforms& grid, const StepUniforms& step, const UpdateMaps& maps) const {
+void UpdatePass::run(const PatchTextures& in, PatchTextures& out, const LiveCount& live, std::size_t slots,
+                     const gl::VolumeTextures& volume, const GridUniforms& grid, const StepUniforms& step,
+                     const UpdateMaps& maps) const {
   gl::ScopedPassBindings unbind;
   out.framebuffer().bind();
-  viewportLiveBox(count);
+  viewportLiveBox(slots);
   program_.use();
   int unit = volume.bind(program_, in.bind(program_, "uPatch", 0));
   if (freeFlight_ != (maps.quiet && *maps.quiet) || absorberMap_ != (maps.absorbers && *maps.absorbers))
     throw std::logic_error("UpdatePass::run: the quiet maps differ from the ones the pass was made for");
   if (freeFlight_) maps.quiet->bind(program_, "uQuietSat", unit++);
   if (absorberMap_) maps.absorbers->bind(program_, "uAbsorberSat", unit++);
+  live.bind(program_, unit++);
   grid.set(program_);
-  program_.set("uCount", static_cast<int>(count));
   program_.set("uDt", step.dt);
   program_.set("uStepDt", step.stepDt);
   program_.set("uStraightReach", step.straightReach);

@@ -7,10 +7,11 @@
 //            |w| = n(x_new); 2 absorption Φ ← Φ·exp(−σa(m_old)·Δs_m); 3 Fresnel boundary
 //            tracking (enter a layer at g > g_on, leave it at g < g_off keeping 1 − R); a patch
 //            in quiet space may instead cross it in one straight step (free flight)
-//   in       list `in` (patches 0 .. count − 1), the volume's n, ∇n, σa, GridUniforms, and of
+//   in       list `in` (patches 0 .. n − 1, n the LiveCount on the GPU; the pass is drawn over
+//            `slots` ≥ n and skips the rest), the volume's n, ∇n, σa, GridUniforms, and of
 //            StepUniforms Δt, g_on, g_off (and the straight step, the flight cap, the split
 //            length and depth limit); the quiet maps of free flight and straight steps (UpdateMaps)
-//   out      list `out` (the same patches, stepped; slots beyond count are left alone)
+//   out      list `out` (the same patches, stepped; slots from n on are left alone)
 //
 // The CPU twin of one patch is stepPatch (cpu_simulator.h), steps 1–3, with advanceCorner.
 #pragma once
@@ -23,6 +24,7 @@
 #include "gl/vertex_array.h"
 #include "gl/volume_textures.h"
 #include "lightsim/grid_uniforms.h"
+#include "lightsim/live_count.h"
 #include "lightsim/patch_textures.h"
 #include "lightsim/quiet_texture.h"
 #include "lightsim/simulator.h"
@@ -46,8 +48,9 @@ class UpdatePass {
   // to read those maps (UpdateMaps).
   UpdatePass(const gl::ShaderLibrary& library, Integrator integrator, const std::string& volumeDefines,
              bool freeFlight = false, bool absorberMap = false);
-  void run(const PatchTextures& in, PatchTextures& out, std::size_t count, const gl::VolumeTextures& volume,
-           const GridUniforms& grid, const StepUniforms& step, const UpdateMaps& maps = {}) const;
+  void run(const PatchTextures& in, PatchTextures& out, const LiveCount& live, std::size_t slots,
+           const gl::VolumeTextures& volume, const GridUniforms& grid, const StepUniforms& step,
+           const UpdateMaps& maps = {}) const;
 
  private:
   gl::Program program_;

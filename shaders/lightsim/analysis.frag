@@ -13,7 +13,7 @@
 //                    atlas x = −1: no deposit. Δs_m = Δt/n(m_old) (Eq. 4.11).
 //   3 ledger A     (flux absorbed in step 2, code = fate + FATE_SPAWNS + FATE_ROLLED_BACK)
 //   4 ledger B     (flux reflected in step 3 and not followed, 1 when it reflected)
-// Slots at or beyond uCount get count 0 and FATE_NONE.
+// Slots at or beyond liveCount() get count 0 and FATE_NONE.
 // RECEIVER: a patch whose midpoint crosses the receiver plane in this step, or that left the box
 // heading for it, is received (receiver.h): its footprint (the corners' rays on the plane) must
 // exist. SHARP_INTERFACES: the update pass's events (sharp.glsl, patch.glsl), blocked and trapped
@@ -21,6 +21,7 @@
 #include "common/volume.glsl"
 #include "lightsim/grid.glsl"
 #include "lightsim/patch.glsl"
+#include "lightsim/live_count.glsl"
 #include "lightsim/fresnel.glsl"
 #include "lightsim/fate.glsl"
 #include "lightsim/atlas.glsl"
@@ -37,7 +38,6 @@ uniform vec3 uReceiverNormal;  // unit, facing the light
 uniform sampler2D uPatch[8];      // the list after the update
 uniform sampler2D uPrevious[4];   // P0..P3 before the update
 uniform sampler2D uPreviousFlux;  // FLUX before the update
-uniform int uCount;
 uniform float uDt;                // Δt
 uniform float uStepDt;            // an ordinary step's time: Δt, or a straight step's (the reach of a reflection)
 
@@ -77,7 +77,7 @@ void main() {
   oDepositA = vec4(0.0, 0.0, 0.0, -1.0);
   oDepositB = vec4(0.0);
   oLedgerB = vec4(0.0);
-  if (mortonIndex(texel) >= uCount) {
+  if (mortonIndex(texel) >= liveCount()) {
     oCount = vec4(0.0);
     oLedgerA = vec4(0.0, 0.0, 0.0, float(FATE_NONE));
     return;

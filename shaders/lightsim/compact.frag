@@ -1,8 +1,8 @@
 #version 330 core
 // ALGORITHM.md step 6, compaction and expansion (Ziegler et al. 2006; thesis §6.2.4): one fragment
-// per slot k of the new list (viewport: its Morton box; slots ≥ uTotal are skipped). The histogram
-// pyramid over the analysis counts gives the source patch s and sub-index j (lightsim/
-// histo_pyramid.glsl). Count 1 copies the patch; a split fate writes child j of its nu × nv split
+// per slot k of the new list (viewport: a Morton box at least as large; slots ≥ the pyramid's
+// total, hpTotal, are skipped). The histogram pyramid over the analysis counts gives the source
+// patch s and sub-index j (lightsim/histo_pyramid.glsl). Count 1 copies the patch; a split fate writes child j of its nu × nv split
 // (2×2, or 1×2 along one axis): corners and w from the bilinear patch (x0 = (0,0), x1 = (1,0),
 // x2 = (1,1), x3 = (0,1)) at the child's parameter cell (j mod nu, j div nu); w renormalised to n
 // at the new corner; Φ_child = Φ·A_child/Σ A (flux conserved); depth + 1 (2×2) or + ½ (1×2),
@@ -26,7 +26,6 @@ uniform float uDt;  // an ordinary step's time, Δt or a straight step's (the re
 uniform sampler2D uPatch[8];   // the updated list (source)
 uniform sampler2D uPyramid;    // histogram pyramid over its counts
 uniform sampler2D uLedgerA;    // the analysis' (absorbed, fate): which split, if any
-uniform int uTotal;            // new list size
 
 layout(location = 0) out vec4 oP0;
 layout(location = 1) out vec4 oP1;
@@ -45,7 +44,7 @@ vec3 bilinear(vec3 c0, vec3 c1, vec3 c2, vec3 c3, float u, float v) {
 void main() {
   ivec2 texel = ivec2(gl_FragCoord.xy);
   int k = hpTexelSlot(texel);
-  if (k >= uTotal) discard;
+  if (k >= hpTotal(uPyramid)) discard;  // the new list's size
   int j;
   ivec2 source = hpFind(uPyramid, k, j);
   Patch p;

@@ -1,6 +1,6 @@
 #version 330 core
 // ALGORITHM.md steps 1–3 for one patch (one texel of the list; the viewport covers the live
-// patches' Morton box, patches ≥ uCount are skipped). Reads the list uPatch, writes the new state
+// patches' Morton box, patches ≥ liveCount() are skipped). Reads the list uPatch, writes the new state
 // to the eight MRT attachments of the other list.
 //   1. Update (thesis §6.2.2): per corner, the time-parameterised ray equation (Eq. 4.12/4.13)
 //      x' = w/n², w' = ∇n/n, stepped with Euler (Eq. 6.1/6.2), RK2 (midpoint) or RK4
@@ -19,10 +19,10 @@
 #include "common/volume.glsl"
 #include "lightsim/grid.glsl"
 #include "lightsim/patch.glsl"
+#include "lightsim/live_count.glsl"
 #include "lightsim/fresnel.glsl"
 
 uniform sampler2D uPatch[8];
-uniform int uCount;            // live patches
 uniform float uDt;             // Δt = step_voxels·h
 uniform float uBoundaryOn;     // g_on  (|∇n|·h entering a layer)
 uniform float uBoundaryOff;    // g_off (|∇n|·h leaving it)
@@ -114,7 +114,7 @@ bool willTear(Patch p, int metMask, float reach) {
 
 void main() {
   ivec2 texel = ivec2(gl_FragCoord.xy);
-  if (mortonIndex(texel) >= uCount) discard;
+  if (mortonIndex(texel) >= liveCount()) discard;
   Patch p;
   FETCH_PATCH(uPatch, texel, p);
   p.event = 0;
@@ -184,7 +184,7 @@ void main() {
 #else
 void main() {
   ivec2 texel = ivec2(gl_FragCoord.xy);
-  if (mortonIndex(texel) >= uCount) discard;
+  if (mortonIndex(texel) >= liveCount()) discard;
   Patch p;
   FETCH_PATCH(uPatch, texel, p);
 
