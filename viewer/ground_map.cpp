@@ -29,16 +29,18 @@ bool receiverChangeAt(const ReceiverLayer& layer, const glm::dvec3& xw, glm::dve
   const glm::dvec2 at = st * glm::dvec2(map.texels) - 0.5;
   const int i0 = static_cast<int>(std::floor(at.x)), j0 = static_cast<int>(std::floor(at.y));
   const double fx = at.x - i0, fy = at.y - j0;
+  const int channels = layer.texels ? 4 : 3;
+  const std::vector<float>& data = layer.texels ? *layer.texels : map.irradiance;
   auto texel = [&](int i, int j) {
     i = std::clamp(i, 0, map.texels.x - 1);
     j = std::clamp(j, 0, map.texels.y - 1);
-    const float* e = &map.irradiance[3 * (static_cast<std::size_t>(j) * static_cast<std::size_t>(map.texels.x) +
-                                          static_cast<std::size_t>(i))];
-    return glm::dvec3(e[0], e[1], e[2]);
+    const float* e = &data[static_cast<std::size_t>(channels) *
+                           (static_cast<std::size_t>(j) * static_cast<std::size_t>(map.texels.x) + static_cast<std::size_t>(i))];
+    return glm::dvec4(e[0], e[1], e[2], channels == 4 ? e[3] : 1.0);
   };
-  const glm::dvec3 E = (1 - fx) * (1 - fy) * texel(i0, j0) + fx * (1 - fy) * texel(i0 + 1, j0) +
+  const glm::dvec4 E = (1 - fx) * (1 - fy) * texel(i0, j0) + fx * (1 - fy) * texel(i0 + 1, j0) +
                        (1 - fx) * fy * texel(i0, j0 + 1) + fx * fy * texel(i0 + 1, j0 + 1);
-  change = E - bakedDirectIrradiance(layer, x, glm::cross(map.u, map.v));
+  change = glm::dvec3(E) - bakedDirectIrradiance(layer, x, glm::cross(map.u, map.v)) * (E.w >= 0.0 ? 1.0 : 2.0);
   return true;
 }
 

@@ -26,6 +26,10 @@ struct ReceiverLayer {
   // travel and its irradiance; w = 1 a point light's position and its intensity.
   glm::dvec4 light_pos{0.0, -1.0, 0.0, 0.0};
   glm::dvec3 light_power{0.0};
+  // The receiver texture the viewer made of the map (shadow_edge.h receiverTexels: rgb the map with
+  // the direct light its geometric shadow takes added back, a the shadow clearance), or null: the
+  // map itself.
+  const std::vector<float>* texels = nullptr;
 };
 
 struct GroundMap {
@@ -44,7 +48,8 @@ glm::dvec3 bakedDirectIrradiance(const ReceiverLayer& layer, const glm::dvec3& x
 
 // The change `layer` makes at world point xw of its plane (object.glsl receiverChange): its map
 // filtered bilinearly (texel centres, clamped at the edges, as the texture is) less the direct
-// light; false where the map does not reach.
+// light; with `texels`, that texture filtered so, less the direct light twice where the filtered
+// clearance is negative (shadow_edge.h). False where the map does not reach.
 bool receiverChangeAt(const ReceiverLayer& layer, const glm::dvec3& xw, glm::dvec3& change);
 
 // The ground map of `layers` on the plane through `point` with unit in-plane axes u, v: it covers

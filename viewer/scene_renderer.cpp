@@ -16,22 +16,11 @@
 #include "gl/volume_textures.h"
 #include "viewer/environment.h"
 #include "viewer/ground_map.h"
+#include "viewer/shadow_edge.h"
 #include "viewer/raymarch_shader.h"
 #include "viewer/volume_analysis.h"
 
 namespace eik {
-
-namespace {
-
-// RGB texels → RGBA (alpha 1): llvmpipe samples RGBA32F faster than RGB32F.
-std::vector<float> padRgba(const std::vector<float>& rgb) {
-  std::vector<float> rgba(rgb.size() / 3 * 4, 1.0f);
-  for (std::size_t t = 0; t < rgb.size() / 3; ++t)
-    for (int c = 0; c < 3; ++c) rgba[4 * t + static_cast<std::size_t>(c)] = rgb[3 * t + static_cast<std::size_t>(c)];
-  return rgba;
-}
-
-}  // namespace
 
 struct SceneRenderer::Impl {
   struct Object {
@@ -99,7 +88,13 @@ struct SceneRenderer::Impl {
         throw InputError(loaded.source, "light", "the baked light is malformed");
       }
       o.receiver = map;  // with its irradiance, for the ground map
-      o.receiver_texture = gl::Texture2D(map.texels, gl::TextureFormat::RGBA32F, padRgba(map.irradiance), 4);
+      // Its shadow's edge to the pixel (shadow_edge.h): directional light, sharp interfaces.
+      ReceiverLayer layer{&o.receiver, o.to_volume, o.to_world, glm::dvec4(o.receiver_light_pos),
+                          glm::dvec3(o.receiver_light_power)};
+      const std::vector<float> clearance =
+          o.receiver_light_pos.w == 0.0f ? shadowClearance(loaded.volume, map, glm::dvec3(o.receiver_light_pos))
+                                          : std::vector<float>();
+      o.receiver_texture = gl::Texture2D(map.texels, gl::TextureFormat::RGBA32F, receiverTexels(layer, clearance), 4);
       o.has_receiver = true;
       return;
     }

@@ -88,7 +88,10 @@ float bakedGroundIrradiance@(vec3 xw, out vec3 E) {
 
 // The change this object's bake makes to the ground's planar irradiance at world point xw: its
 // receiver map there minus the direct light it was baked with (its shadow, its caustic, what it
-// reflects onto the ground). False where the map does not reach (GROUND, HAS_RECEIVER).
+// reflects onto the ground). The texture (viewer/shadow_edge.h) holds the map with the direct
+// light its geometric shadow takes added back, and in .a the shadow's clearance, whose sign cuts
+// the direct light off at the pixel: the change is rgb − D where a ≥ 0, rgb − 2D where a < 0.
+// False where the map does not reach (GROUND, HAS_RECEIVER).
 #ifdef GROUND
 bool receiverChange@(vec3 xw, out vec3 change) {
   change = vec3(0.0);
@@ -100,7 +103,9 @@ bool receiverChange@(vec3 xw, out vec3 change) {
   covered = all(greaterThanEqual(st, vec2(0.0))) && all(lessThanEqual(st, vec2(1.0)));
   if (covered) {
     vec3 normal = cross(uObjRecvU[@], uObjRecvV[@]);
-    change = texture(uO@Receiver, st).rgb - lightIrradiance(uObjRecvLightPos[@], uObjRecvLightPower[@], x, normal);
+    vec4 m = texture(uO@Receiver, st);
+    vec3 direct = lightIrradiance(uObjRecvLightPos[@], uObjRecvLightPower[@], x, normal);
+    change = m.rgb - direct * (m.a >= 0.0 ? 1.0 : 2.0);
   }
 #endif
   return covered;

@@ -1,0 +1,243 @@
+// Sharp shadow edges on the ground (see shadow_edge.h).
+#include "viewer/shadow_edge.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "core/interfaces.h"
+#include "core/parallel.h"
+
+namespace eik {
+namespace {
+
+// The union of the slots' solids as a signed distance: the least of the slots' trilinear distances
+// (voxel centres, clamped at the grid's faces as the textures are).
+struct UnionDistance {
+  const GridSpec& grid;
+  const Field& field;
+  int slots;
+
+  double at(const glm::dvec3& x) const {
+    const glm::dvec3 g = grid.toVoxel(x) - 0.5;
+    const glm::ivec3 hi = grid.dims - 1;
+    const glm::dvec3 f0 = glm::floor(g);
+    const glm::dvec3 f = g - f0;
+    const glm::ivec3 i0 = glm::clamp(glm::ivec3(f0), glm::ivec3(0), hi);
+    const glm::ivec3 i1 = glm::clamp(glm::ivec3(f0) + 1, glm::ivec3(0), hi);
+    double best = 1e30;
+    for (int k = 0; k < slots; ++k) {
+      auto d = [&](int x, int y, int z) { return static_cast<double>(field.voxel(grid.index(x, y, z))[k]); };
+      const double c00 = d(i0.x, i0.y, i0.z) * (1 - f.x) + d(i1.x, i0.y, i0.z) * f.x;
+      const double c10 = d(i0.x, i1.y, i0.z) * (1 - f.x) + d(i1.x, i1.y, i0.z) * f.x;
+      const double c01 = d(i0.x, i0.y, i1.z) * (1 - f.x) + d(i1.x, i0.y, i1.z) * f.x;
+      const double c11 = d(i0.x, i1.y, i1.z) * (1 - f.x) + d(i1.x, i1.y, i1.z) * f.x;
+      const double v = (c00 * (1 - f.y) + c10 * f.y) * (1 - f.z) + (c01 * (1 - f.y) + c11 * f.y) * f.z;
+      best = std::min(best, v);
+    }
+    return best;
+  }
+};
+
+// [t0, t1] of the ray p + t·d (t ≥ 0) inside the box; false when it misses.
+bool clipToBox(const glm::dvec3& p, const glm::dvec3& d, const glm::dvec3& lo, const glm::dvec3& hi, double& t0,
+               double& t1) {
+  t0 = 0.0;
+  t1 = 1e30;
+  for (int a = 0; a < 3; ++a) {
+    if (std::abs(d[a]) < 1e-15) {
+      if (p[a] < lo[a] || p[a] > hi[a]) return false;
+      continue;
+    }
+    double ta = (lo[a] - p[a]) / d[a], tb = (hi[a] - p[a]) / d[a];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  return t0 <= t1;
+}
+
+// The box of the voxel centres whose least slot distance is under the band; false when none is.
+bool nearSurfaces(const GridSpec& grid, const Field& field, int slots, double band, glm::dvec3& lo, glm::dvec3& hi) {
+  const glm::ivec3 dims = grid.dims;
+  std::vector<glm::ivec3> slabLo(static_cast<std::size_t>(dims.z), glm::ivec3(INT32_MAX)),
+      slabHi(static_cast<std::size_t>(dims.z), glm::ivec3(-1));
+  const auto limit = static_cast<float>(band * (1.0 - 1e-6));
+  parallelFor(0, dims.z, [&](std::int64_t z) {
+    glm::ivec3& l = slabLo[static_cast<std::size_t>(z)];
+    glm::ivec3& u = slabHi[static_cast<std::size_t>(z)];
+    for (int y = 0; y < dims.y; ++y) {
+      const float* row = field.voxel(grid.index(0, y, static_cast<int>(z)));
+      for (int x = 0; x < dims.x; ++x) {
+        const float* d = row + static_cast<std::size_t>(x) * static_cast<std::size_t>(field.components);
+        bool near = false;
+        for (int k = 0; k < slots; ++k) near = near || d[k] < limit;
+        if (!near) continue;
+        l = glm::min(l, glm::ivec3(x, y, static_cast<int>(z)));
+        u = glm::max(u, glm::ivec3(x, y, static_cast<int>(z)));
+      }
+    }
+  });
+  glm::ivec3 l(INT32_MAX), u(-1);
+  for (std::size_t z = 0; z < slabLo.size(); ++z) {
+    l = glm::min(l, slabLo[z]);
+    u = glm::max(u, slabHi[z]);
+  }
+  if (u.x < 0) return false;
+  lo = grid.center(l.x, l.y, l.z);
+  hi = grid.center(u.x, u.y, u.z);
+  return true;
+}
+
+}  // namespace
+
+std::vector<float> shadowClearance(const Volume& volume, const ReceiverMap& map, const glm::dvec3& direction) {
+  const Field* field = volume.find("interfaces");
+  const InterfaceTable table = interfaceTable(volume);
+  if (!field || table.empty() || glm::dot(direction, direction) <= 0.0) return {};
+  const GridSpec& grid = volume.grid;
+  const UnionDistance sdf{grid, *field, static_cast<int>(table.slots.size())};
+  const glm::dvec3 voxel = grid.voxelSize();
+  const double h = std::min({voxel.x, voxel.y, voxel.z});
+  const double band = table.band > 0.0 ? table.band : kInterfaceBandVoxels * h;
+  // The march: steps of the distance itself where it is larger (nothing nearer can be skipped: a
+  // distance field changes by at most the step), half a voxel near and inside the surfaces
+  // (the least distance of a grazing ray is then found within h²/(32 R), R the surface's radius of
+  // curvature), and it stops three voxels inside (only the sign and the edge's neighbourhood
+  // matter).
+  const double fine = 0.5 * h, deep = -3.0 * h;
+  const glm::dvec3 toLight = -glm::normalize(direction);
+  // Only the box of the voxels nearer than the band to a surface (grown by a voxel) is marched:
+  // elsewhere the distance is the band.
+  glm::dvec3 lo, hi;
+  if (!nearSurfaces(grid, *field, sdf.slots, band, lo, hi)) return std::vector<float>(map.texelCount(), static_cast<float>(band));
+  lo -= glm::dvec3(h);
+  hi += glm::dvec3(h);
+  auto march = [&](int i, int j) {
+    const glm::dvec3 p = map.texelCenter(i, j);
+    double t0 = 0.0, t1 = 0.0;
+    if (!clipToBox(p, toLight, lo, hi, t0, t1)) return band;
+    double best = band;
+    for (double t = t0; t <= t1;) {
+      const double d = sdf.at(p + t * toLight);
+      best = std::min(best, d);
+      if (best < deep) break;
+      t += std::max(d, fine);
+    }
+    return best;
+  };
+  // Coarse to fine: c at every kBlock-th texel first; a block whose four corners have one sign and
+  // |c| over the block's edge keeps that sign throughout (c changes by at most the distance moved:
+  // the distance field is 1-Lipschitz, so is its least value along a shifted ray) and gets the
+  // corners' bilinear c (only its sign is read there); the blocks the edge may cross are marched
+  // texel by texel.
+  constexpr int kBlock = 8;
+  const int nx = map.texels.x, ny = map.texels.y;
+  const int bx = (nx + kBlock - 1) / kBlock, by = (ny + kBlock - 1) / kBlock;
+  std::vector<double> coarse(static_cast<std::size_t>(bx + 1) * static_cast<std::size_t>(by + 1));
+  parallelFor(
+      0, by + 1,
+      [&](std::int64_t cj) {
+        for (int ci = 0; ci <= bx; ++ci)
+          coarse[static_cast<std::size_t>(cj) * static_cast<std::size_t>(bx + 1) + static_cast<std::size_t>(ci)] =
+              march(std::min(ci * kBlock, nx - 1), std::min(static_cast<int>(cj) * kBlock, ny - 1));
+      },
+      4);
+  // Every texel of a block lies within half the block's diagonal of a corner (and the band, where
+  // c is clamped, is 16 texels of the default pitch).
+  const double sure = 0.75 * kBlock * map.pitch;
+  std::vector<float> clearance(map.texelCount(), static_cast<float>(band));
+  parallelFor(
+      0, static_cast<std::int64_t>(bx) * by,
+      [&](std::int64_t b) {
+        const int bi = static_cast<int>(b % bx), bj = static_cast<int>(b / bx);
+        const double* row0 = &coarse[static_cast<std::size_t>(bj) * static_cast<std::size_t>(bx + 1)];
+        const double* row1 = row0 + (bx + 1);
+        const double c00 = row0[bi], c10 = row0[bi + 1], c01 = row1[bi], c11 = row1[bi + 1];
+        const bool lit = c00 > sure && c10 > sure && c01 > sure && c11 > sure;
+        const bool dark = c00 < -sure && c10 < -sure && c01 < -sure && c11 < -sure;
+        // The corners' texels: the next block's first texel, or the last texel of the map.
+        const int i0 = bi * kBlock, j0 = bj * kBlock;
+        const int i1 = std::min(i0 + kBlock, nx - 1), j1 = std::min(j0 + kBlock, ny - 1);
+        for (int j = j0; j < std::min(j0 + kBlock, ny); ++j) {
+          for (int i = i0; i < std::min(i0 + kBlock, nx); ++i) {
+            double c = 0.0;
+            if (lit || dark) {
+              const double fx = i1 > i0 ? double(i - i0) / (i1 - i0) : 0.0, fy = j1 > j0 ? double(j - j0) / (j1 - j0) : 0.0;
+              c = (1 - fx) * (1 - fy) * c00 + fx * (1 - fy) * c10 + (1 - fx) * fy * c01 + fx * fy * c11;
+            } else {
+              c = march(i, j);
+            }
+            clearance[static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i)] =
+                static_cast<float>(c);
+          }
+        }
+      },
+      4);
+  return clearance;
+}
+
+std::vector<float> receiverTexels(const ReceiverLayer& layer, const std::vector<float>& clearance) {
+  const ReceiverMap& map = *layer.map;
+  const std::size_t n = map.texelCount();
+  std::vector<float> rgba(4 * n);
+  parallelFor(0, static_cast<std::int64_t>(map.texels.y), [&](std::int64_t row) {
+    const std::size_t first = static_cast<std::size_t>(row) * static_cast<std::size_t>(map.texels.x);
+    for (std::size_t t = first; t < first + static_cast<std::size_t>(map.texels.x); ++t) {
+      for (int c = 0; c < 3; ++c) rgba[4 * t + static_cast<std::size_t>(c)] = map.irradiance[3 * t + static_cast<std::size_t>(c)];
+      rgba[4 * t + 3] = clearance.size() == n ? clearance[t] : 1.0f;
+    }
+  }, 16);
+  if (clearance.size() != n) return rgba;
+  const int nx = map.texels.x, ny = map.texels.y;
+  auto c = [&](int i, int j) {
+    return static_cast<double>(clearance[static_cast<std::size_t>(std::clamp(j, 0, ny - 1)) * static_cast<std::size_t>(nx) +
+                                         static_cast<std::size_t>(std::clamp(i, 0, nx - 1))]);
+  };
+  const glm::dvec3 normal = glm::cross(map.u, map.v);
+  parallelFor(0, ny, [&](std::int64_t row) {
+    const int j = static_cast<int>(row);
+    for (int i = 0; i < nx; ++i) {
+      const std::size_t t = static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i);
+      // The lit fraction s: only where the bilinear c changes sign within the texel, i.e. where
+      // the texel or a neighbour has the other sign.
+      const double c0 = c(i, j);
+      bool mixed = false;
+      if (std::abs(c0) > 2.0 * map.pitch) {  // the neighbours are within 1.5 pitches: the same sign
+        if (c0 < 0.0) {
+          const glm::dvec3 D = bakedDirectIrradiance(layer, map.texelCenter(i, j), normal);
+          for (int k = 0; k < 3; ++k) rgba[4 * t + static_cast<std::size_t>(k)] += static_cast<float>(D[k]);
+        }
+        continue;
+      }
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int di = -1; di <= 1; ++di) mixed = mixed || ((c(i + di, j + dj) >= 0.0) != (c0 >= 0.0));
+      if (!mixed) {
+        if (c0 < 0.0) {
+          const glm::dvec3 D = bakedDirectIrradiance(layer, map.texelCenter(i, j), normal);
+          for (int k = 0; k < 3; ++k) rgba[4 * t + static_cast<std::size_t>(k)] += static_cast<float>(D[k]);
+        }
+        continue;
+      }
+      // 8×8 points of the texel, each at offset (a, b) ∈ (−½, ½)² from its centre: the bilinear c
+      // between the centres around it, as the texture unit interpolates it.
+      int lit = 0;
+      for (int sb = 0; sb < 8; ++sb) {
+        for (int sa = 0; sa < 8; ++sa) {
+          const double a = (sa + 0.5) / 8.0 - 0.5, b = (sb + 0.5) / 8.0 - 0.5;
+          const int ia = a < 0.0 ? i - 1 : i, jb = b < 0.0 ? j - 1 : j;
+          const double fx = a < 0.0 ? 1.0 + a : a, fy = b < 0.0 ? 1.0 + b : b;
+          const double v = (1 - fx) * (1 - fy) * c(ia, jb) + fx * (1 - fy) * c(ia + 1, jb) +
+                           (1 - fx) * fy * c(ia, jb + 1) + fx * fy * c(ia + 1, jb + 1);
+          lit += v >= 0.0;
+        }
+      }
+      const double s = lit / 64.0;
+      const glm::dvec3 D = bakedDirectIrradiance(layer, map.texelCenter(i, j), normal);
+      for (int k = 0; k < 3; ++k) rgba[4 * t + static_cast<std::size_t>(k)] += static_cast<float>(D[k] * (1.0 - s));
+    }
+  }, 16);
+  return rgba;
+}
+
+}  // namespace eik

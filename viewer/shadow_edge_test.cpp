@@ -1,0 +1,146 @@
+// Tests of viewer/shadow_edge: the shadow clearance of a sharp sphere against the exact distance
+// of the light's ray from it, at two resolutions, and the receiver texture against a map of
+// known light and shadow (the lit fraction of the texels the edge crosses, the change the ground
+// shows on either side of the edge).
+#include "viewer/shadow_edge.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "lightsim/test_scenes.h"
+
+namespace eik {
+namespace {
+
+ReceiverMap floorMap(glm::dvec2 origin, double pitch, glm::ivec2 texels) {
+  ReceiverMap map;
+  map.point = glm::dvec3(0.0);
+  map.normal = glm::dvec3(0.0, 1.0, 0.0);
+  receiverAxes(map.normal, map.u, map.v);
+  map.origin = origin;
+  map.pitch = pitch;
+  map.texels = texels;
+  map.irradiance.assign(3 * map.texelCount(), 0.0f);
+  return map;
+}
+
+// A sphere R = 0.3 at height 0.5 under a light straight down: the ray up from (x, 0, z) passes
+// the centre at ρ = |(x, z)|, so its least signed distance from the sphere is ρ − R, on both
+// sides of the edge (inside, the deepest point of the chord is ρ − R below the surface). Its value
+// is checked within a quarter voxel of the edge (the texels the lookup reads there; farther away
+// only its sign matters, and blocks of texels get their corners' interpolation), its sign
+// everywhere.
+TEST(ShadowEdge, TheClearanceOfASphereIsTheLightRaysDistanceFromIt) {
+  const double R = 0.3;
+  double worst[2] = {0.0, 0.0};
+  const int resolutions[2] = {32, 64};
+  for (int r = 0; r < 2; ++r) {
+    const Volume volume = test_scenes::sharpVolume("procedural:sphere,r=0.3,center=0:0.5:0,ior=1.5", resolutions[r],
+                                                   test_scenes::box({-0.4, 0.1, -0.4}, {0.4, 0.9, 0.4}));
+    const double h = volume.grid.voxelSize().x;
+    const ReceiverMap map = floorMap({-0.45, -0.45}, 0.005, {180, 180});
+    const std::vector<float> c = shadowClearance(volume, map, {0.0, -1.0, 0.0});
+    ASSERT_EQ(c.size(), map.texelCount());
+    int checked = 0;
+    for (int j = 0; j < map.texels.y; ++j) {
+      for (int i = 0; i < map.texels.x; ++i) {
+        const glm::dvec3 p = map.texelCenter(i, j);
+        const double exact = std::hypot(p.x, p.z) - R;
+        const double got = c[static_cast<std::size_t>(j) * 180 + static_cast<std::size_t>(i)];
+        if (std::abs(exact) < 0.25 * h) {  // the edge's texels: marched one by one
+          worst[r] = std::max(worst[r], std::abs(got - exact) / h);
+          ++checked;
+        }
+        if (std::abs(exact) < 0.02 * h) continue;  // the sign is right to within the error below
+        if (exact > 0.0) {
+          ASSERT_GT(got, 0.0) << p.x << ", " << p.z;  // lit, however far
+        } else {
+          ASSERT_LT(got, 0.0) << p.x << ", " << p.z;  // in the shadow
+        }
+      }
+    }
+    std::printf("%d³: clearance within %.4f voxel of ρ − R over the %d texels of the edge\n", resolutions[r], worst[r],
+                checked);
+    EXPECT_GT(checked, 400);  // a ring of 2·0.25h around R = 0.3 in texels of 0.005
+  }
+  // The voxelizer's distances and their trilinear interpolation near a surface of radius
+  // R = 12–24 voxels: second order in h/R, a few hundredths of a voxel; the march finds the least distance of a grazing ray within h²/(32R). 0.06
+  // voxel is a quarter of a texel of the bake's default pitch (a quarter voxel); in voxels the
+  // error falls with the resolution (first order in h/R).
+  EXPECT_LT(worst[0], 0.06);
+  EXPECT_LT(worst[1], 0.6 * worst[0]);
+  // The sun's ray missing the grid's box altogether: lit.
+  const Volume volume = test_scenes::sharpVolume("procedural:sphere,r=0.3,center=0:0.5:0,ior=1.5", 32,
+                                                 test_scenes::box({-0.4, 0.1, -0.4}, {0.4, 0.9, 0.4}));
+  const ReceiverMap far = floorMap({2.0, 2.0}, 0.1, {4, 4});
+  for (float v : shadowClearance(volume, far, {0.0, -1.0, 0.0})) EXPECT_GT(v, 0.0f);
+  // No interfaces: no clearance.
+  Volume smooth = volume;
+  smooth.fields.erase("interfaces");
+  smooth.metadata.erase("interfaces");
+  EXPECT_TRUE(shadowClearance(smooth, far, {0.0, -1.0, 0.0}).empty());
+}
+
+// A map of a straight shadow edge at u = e (lit for u ≥ e) under D = 2 W/m², plus light C(u, v)
+// that is linear (a caustic's slope): each texel holds its mean, D·s_true + C(centre), s_true the
+// part of the texel at u ≥ e. With the clearance c = u − e, the texture adds back D·(1 − s) and
+// the change the ground shows, rgb − D·(2 − lit) at lit = [bilinear c ≥ 0], is C − D·[u < e] at
+// any point: the edge where it is, not spread over two texels.
+TEST(ShadowEdge, TheGroundShowsTheEdgeWhereTheClearanceChangesSign) {
+  const double pitch = 0.1, e = 0.33, D = 2.0;
+  ReceiverMap map = floorMap({0.0, 0.0}, pitch, {10, 6});
+  auto C = [](glm::dvec2 uv) { return 0.5 + 0.8 * uv.x - 0.3 * uv.y; };
+  std::vector<float> clearance(map.texelCount());
+  for (int j = 0; j < map.texels.y; ++j) {
+    for (int i = 0; i < map.texels.x; ++i) {
+      const glm::dvec2 centre((i + 0.5) * pitch, (j + 0.5) * pitch);
+      const double s = std::clamp((centre.x + 0.5 * pitch - e) / pitch, 0.0, 1.0);
+      const std::size_t t = static_cast<std::size_t>(j) * 10 + static_cast<std::size_t>(i);
+      for (int k = 0; k < 3; ++k) map.irradiance[3 * t + static_cast<std::size_t>(k)] = static_cast<float>(D * s + C(centre));
+      clearance[t] = static_cast<float>(centre.x - e);
+    }
+  }
+  ReceiverLayer layer;
+  layer.map = &map;
+  layer.light_pos = glm::dvec4(0.0, -1.0, 0.0, 0.0);
+  layer.light_power = glm::dvec3(D);
+  const std::vector<float> texels = receiverTexels(layer, clearance);
+  ASSERT_EQ(texels.size(), 4 * map.texelCount());
+  // Texel 3 (u in [0.3, 0.4)) is the one the edge crosses: lit 7/10 of it; the 8×8 points find
+  // 6/8 (those at u ≥ 0.33), so it gets D·(1 − 0.75) back. The others: nothing in the light, D
+  // in the shadow.
+  for (int i = 0; i < 10; ++i) {
+    const std::size_t t = static_cast<std::size_t>(2 * 10 + i);
+    const double s_true = std::clamp(((i + 1) * pitch - e) / pitch, 0.0, 1.0);
+    const double s = i == 3 ? 0.75 : s_true;
+    EXPECT_NEAR(texels[4 * t], map.irradiance[3 * t] + D * (1.0 - s), 1e-5) << i;
+    EXPECT_FLOAT_EQ(texels[4 * t + 3], clearance[t]);
+  }
+  // The change at points across the edge, a tenth of a texel apart, away from the map's border.
+  layer.texels = &texels;
+  double worst = 0.0, worst_old = 0.0;
+  for (double u = 0.16; u <= 0.5; u += 0.01) {
+    const glm::dvec3 x = map.point + u * map.u + 0.27 * map.v;
+    glm::dvec3 change;
+    ASSERT_TRUE(receiverChangeAt(layer, x, change));
+    const double want = C({u, 0.27}) - (u < e ? D : 0.0);
+    worst = std::max(worst, std::abs(change.x - want));
+    ReceiverLayer plain = layer;
+    plain.texels = nullptr;
+    glm::dvec3 old;
+    ASSERT_TRUE(receiverChangeAt(plain, x, old));
+    worst_old = std::max(worst_old, std::abs(old.x - want));
+  }
+  std::printf("change across the edge: worst %.4f W/m² (the map alone: %.4f) of D = %.1f\n", worst, worst_old, D);
+  // What is left is the 8×8 points' estimate of the crossed texel's lit part (0.75 for 0.7), which
+  // its bilinear neighbourhood weighs by at most 1: D·0.05.
+  EXPECT_LE(worst, D * 0.05 + 1e-5);
+  EXPECT_GT(worst_old, 0.3 * D);  // the map alone smears the edge over a texel
+}
+
+}  // namespace
+}  // namespace eik
