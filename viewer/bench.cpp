@@ -130,7 +130,7 @@ BenchReport runBench(const std::function<void()>& draw_full, const BareMarch& ba
   BenchReport report;
   report.frames = frames;
   report.size = size;
-  gl::Framebuffer target(size, {gl::TextureFormat::RGBA32F});
+  gl::Framebuffer target(size, {gl::TextureFormat::RGBA32F}, /*depth=*/true);  // as render() draws (two-pass dispersion)
   const double steps = bare.countSteps(camera, size);
   // Interleaved, full then bare in every round, so that both see the same machine load (a busy
   // machine otherwise biases whichever runs second).

@@ -57,6 +57,14 @@ struct SceneRenderer::Impl {
   gl::Texture2D ground_texture;
   gl::Program program;
   std::string program_key;  // the defines the program was built with
+  // DISPERSION in two passes (draw): `program` traces green and marks in the depth buffer where it
+  // went through dispersive glass; `red_blue` traces red and blue there only (the depth test keeps
+  // the rest from being shaded). `single` does all three in one pass, for a target without depth
+  // (made when first needed).
+  bool two_pass = false;
+  gl::Program red_blue, single;
+  std::vector<RaymarchObject> shapes;  // of the last build, for `single`
+  gl::ShaderDefines program_defines;
   gl::FullscreenTriangle triangle;
 
   Impl(const gl::ShaderLibrary& library, const LoadedScene& loaded)
@@ -173,16 +181,31 @@ struct SceneRenderer::Impl {
     std::string key;
     for (const auto& [name, value] : defs) key += name + "=" + value + ";";
     if (program && key == program_key) return;
-    std::vector<RaymarchObject> shapes;
+    shapes.clear();
     for (const Object& o : objects) shapes.push_back({o.textures.layout(), o.sharp_faces, o.defines});
     gl::ShaderSource vertex = shaders.source("common/fullscreen.vert");
-    program = gl::Program(vertex, raymarchFragmentSource(shaders, defs, shapes));
+    two_pass = std::any_of(defs.begin(), defs.end(), [](const auto& d) { return d.first == "DISPERSION"; });
+    program_defines = defs;
+    single = gl::Program();
+    if (two_pass) {
+      gl::ShaderDefines green = defs, rb = defs;
+      green.emplace_back("DISPERSION_GREEN_PASS", "1");
+      rb.emplace_back("DISPERSION_RED_BLUE_PASS", "1");
+      program = gl::Program(vertex, raymarchFragmentSource(shaders, green, shapes));
+      red_blue = gl::Program(shaders.source("common/fullscreen.vert"), raymarchFragmentSource(shaders, rb, shapes));
+    } else {
+      program = gl::Program(vertex, raymarchFragmentSource(shaders, defs, shapes));
+      red_blue = gl::Program();
+    }
     program_key = key;
   }
+  const gl::Program& singlePass() {
+    if (!single) single = gl::Program(shaders.source("common/fullscreen.vert"), raymarchFragmentSource(shaders, program_defines, shapes));
+    return single;
+  }
 
-  void setUniforms(const Camera& camera, glm::ivec2 size) {
+  void setUniforms(const gl::Program& p, const Camera& camera, glm::ivec2 size) {
     const double aspect = static_cast<double>(size.x) / static_cast<double>(size.y);
-    const gl::Program& p = program;
     p.set("uInvViewProj", glm::mat4(camera.inverseViewProjection(aspect)));
     p.set("uEye", glm::vec3(camera.eye));
     const float pixel_spread = static_cast<float>(2.0 * std::tan(glm::radians(camera.fov_y_deg) / 2) / size.y);
@@ -340,15 +363,53 @@ int SceneRenderer::objectCount() const { return static_cast<int>(impl_->objects.
 
 bool SceneRenderer::usesGroundMap() const { return impl_->has_ground_map; }
 
+namespace {
+// Whether the framebuffer bound for drawing has a depth buffer (the default framebuffer: taken as
+// not, windows here draw into their own).
+bool drawTargetHasDepth() {
+  GLint bound = 0;
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &bound);
+  if (bound == 0) return false;
+  GLint type = GL_NONE;
+  glGetFramebufferAttachmentParameteriv(GL_DRAW_FRAMEBUFFER, GL_DEPTH_ATTACHMENT,
+                                        GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
+  return type != GL_NONE;
+}
+}  // namespace
+
 void SceneRenderer::draw(const Camera& camera, glm::ivec2 size) {
-  impl_->setUniforms(camera, size);
-  impl_->program.use();
+  Impl& s = *impl_;
   glViewport(0, 0, size.x, size.y);
-  impl_->triangle.draw();
+  if (!s.two_pass || !drawTargetHasDepth()) {
+    const gl::Program& p = s.two_pass ? s.singlePass() : s.program;
+    s.setUniforms(p, camera, size);
+    p.use();
+    s.triangle.draw();
+    return;
+  }
+  // Green everywhere, its depth 0 where it went through dispersive glass and 1 elsewhere; then red
+  // and blue over a triangle at depth ½ that passes (GREATER) only where green wrote 0, into the
+  // red and blue channels alone.
+  s.setUniforms(s.program, camera, size);
+  s.setUniforms(s.red_blue, camera, size);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_ALWAYS);
+  glDepthMask(GL_TRUE);
+  s.program.use();
+  s.triangle.draw();
+  glDepthFunc(GL_GREATER);
+  glDepthMask(GL_FALSE);
+  glColorMask(GL_TRUE, GL_FALSE, GL_TRUE, GL_FALSE);
+  s.red_blue.use();
+  s.triangle.draw();
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glDepthMask(GL_TRUE);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_DEPTH_TEST);
 }
 
 Image SceneRenderer::render(const Camera& camera, glm::ivec2 size) {
-  gl::Framebuffer target(size, {gl::TextureFormat::RGBA32F});
+  gl::Framebuffer target(size, {gl::TextureFormat::RGBA32F}, /*depth=*/true);
   target.bind();
   draw(camera, size);
   return readLinearImage(target);

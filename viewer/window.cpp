@@ -366,7 +366,7 @@ int runViewerWindow(const LoadedScene& scene, const RenderSettings& initial_sett
     const float scale = dragging ? drag_scale : scripted ? 1.0f : resolution_scale;
     const glm::ivec2 render_size = glm::max(glm::ivec2(glm::round(glm::vec2(fb) * scale)), glm::ivec2(1));
     if (!hdr || hdr.size() != render_size) {
-      hdr = gl::Framebuffer(render_size, {gl::TextureFormat::RGBA32F});
+      hdr = gl::Framebuffer(render_size, {gl::TextureFormat::RGBA32F}, /*depth=*/true);  // two-pass dispersion
       dirty = true;
     }
     if (dirty || scripted) {

@@ -267,6 +267,20 @@ void main() {
   // elsewhere all three take the same path and green's RGB is each channel's own.
   const vec3 lambda = vec3(0.61, 0.55, 0.465);
   vec3 cauchy = 1.0 / (lambda * lambda) - vec3(1.0 / (0.5876 * 0.5876));
+#if defined(DISPERSION_GREEN_PASS)
+  // Two passes (SceneRenderer::draw): green here, and in the depth buffer where it went through
+  // dispersive glass (0) or not (1); red and blue follow in a pass the depth test confines there.
+  Ray green = primaryRay();
+  trace(green, cauchy[1]);
+  gl_FragDepth = green.dispersed ? 0.0 : 1.0;
+  outColor = vec4(finish(green), 1.0);
+#elif defined(DISPERSION_RED_BLUE_PASS)
+  Ray red = primaryRay();
+  trace(red, cauchy[0]);
+  Ray blue = primaryRay();
+  trace(blue, cauchy[2]);
+  outColor = vec4(finish(red).r, 0.0, finish(blue).b, 1.0);  // green's channel is masked off
+#else
   Ray green = primaryRay();
   trace(green, cauchy[1]);
   Ray red = green, blue = green;
@@ -277,6 +291,7 @@ void main() {
     trace(blue, cauchy[2]);
   }
   outColor = vec4(finish(red).r, finish(green).g, finish(blue).b, 1.0);  // uniform control flow
+#endif
 #else
   Ray r = primaryRay();
   trace(r, 0.0);
