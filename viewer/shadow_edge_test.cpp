@@ -16,10 +16,9 @@
 namespace eik {
 namespace {
 
+// A dark map on the plane y = 0, facing +y (ReceiverMap's point and normal as they start).
 ReceiverMap floorMap(glm::dvec2 origin, double pitch, glm::ivec2 texels) {
   ReceiverMap map;
-  map.point = glm::dvec3(0.0);
-  map.normal = glm::dvec3(0.0, 1.0, 0.0);
   receiverAxes(map.normal, map.u, map.v);
   map.origin = origin;
   map.pitch = pitch;
