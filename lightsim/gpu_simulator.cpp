@@ -485,11 +485,8 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     live.request();  // the new count
     std::unique_ptr<gpu::ListSet> grown;
     const std::uint64_t bound = std::uint64_t{GpuSimulatorOptions::kMaxChildren} * count;
-    if (overlap && bound <= L.a.capacity()) {
-      haveCount = false;
-      slots = bound;
-    } else if (overlap && (grown = listFor(bound, s, false))) {
-      haveCount = false;
+    if (overlap && (bound <= L.a.capacity() || (grown = listFor(bound, s, false)))) {
+      haveCount = false;  // collected in the next step
       slots = bound;
     } else {
       ++info.waited_counts;

@@ -180,63 +180,55 @@ std::vector<float> shadowClearance(const Volume& volume, const ReceiverMap& map,
 std::vector<float> receiverTexels(const ReceiverLayer& layer, const std::vector<float>& clearance) {
   const ReceiverMap& map = *layer.map;
   const std::size_t n = map.texelCount();
-  std::vector<float> rgba(4 * n);
-  parallelFor(0, static_cast<std::int64_t>(map.texels.y), [&](std::int64_t row) {
-    const std::size_t first = static_cast<std::size_t>(row) * static_cast<std::size_t>(map.texels.x);
-    for (std::size_t t = first; t < first + static_cast<std::size_t>(map.texels.x); ++t) {
-      for (int c = 0; c < 3; ++c) rgba[4 * t + static_cast<std::size_t>(c)] = map.irradiance[3 * t + static_cast<std::size_t>(c)];
-      rgba[4 * t + 3] = clearance.size() == n ? clearance[t] : 1.0f;
-    }
-  }, 16);
-  if (clearance.size() != n) return rgba;
+  const bool edges = clearance.size() == n;
   const int nx = map.texels.x, ny = map.texels.y;
   auto c = [&](int i, int j) {
     return static_cast<double>(clearance[static_cast<std::size_t>(std::clamp(j, 0, ny - 1)) * static_cast<std::size_t>(nx) +
                                          static_cast<std::size_t>(std::clamp(i, 0, nx - 1))]);
   };
-  const glm::dvec3 normal = glm::cross(map.u, map.v);
-  parallelFor(0, ny, [&](std::int64_t row) {
-    const int j = static_cast<int>(row);
-    for (int i = 0; i < nx; ++i) {
-      const std::size_t t = static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i);
-      // The lit fraction s: only where the bilinear c changes sign within the texel, i.e. where
-      // the texel or a neighbour has the other sign.
-      const double c0 = c(i, j);
-      bool mixed = false;
-      if (std::abs(c0) > 2.0 * map.pitch) {  // the neighbours are within 1.5 pitches: the same sign
-        if (c0 < 0.0) {
-          const glm::dvec3 D = bakedDirectIrradiance(layer, map.texelCenter(i, j), normal);
-          for (int k = 0; k < 3; ++k) rgba[4 * t + static_cast<std::size_t>(k)] += static_cast<float>(D[k]);
-        }
-        continue;
+  // The lit fraction of texel (i, j): 0 or 1 unless the bilinear c changes sign within it, i.e.
+  // the texel or a neighbour has the other sign (none can within 2 pitches: they lie within 1.5);
+  // then 8×8 points of the texel, each at offset (a, b) ∈ (−½, ½)² from its centre, of the bilinear
+  // c between the centres around it, as the texture unit interpolates it.
+  auto litFraction = [&](int i, int j) {
+    const double c0 = c(i, j);
+    const double whole = c0 >= 0.0 ? 1.0 : 0.0;
+    if (std::abs(c0) > 2.0 * map.pitch) return whole;
+    bool mixed = false;
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int di = -1; di <= 1; ++di) mixed = mixed || ((c(i + di, j + dj) >= 0.0) != (c0 >= 0.0));
+    if (!mixed) return whole;
+    int lit = 0;
+    for (int sb = 0; sb < 8; ++sb) {
+      for (int sa = 0; sa < 8; ++sa) {
+        const double a = (sa + 0.5) / 8.0 - 0.5, b = (sb + 0.5) / 8.0 - 0.5;
+        const int ia = a < 0.0 ? i - 1 : i, jb = b < 0.0 ? j - 1 : j;
+        const double fx = a < 0.0 ? 1.0 + a : a, fy = b < 0.0 ? 1.0 + b : b;
+        const double v = (1 - fx) * (1 - fy) * c(ia, jb) + fx * (1 - fy) * c(ia + 1, jb) +
+                         (1 - fx) * fy * c(ia, jb + 1) + fx * fy * c(ia + 1, jb + 1);
+        lit += v >= 0.0;
       }
-      for (int dj = -1; dj <= 1; ++dj)
-        for (int di = -1; di <= 1; ++di) mixed = mixed || ((c(i + di, j + dj) >= 0.0) != (c0 >= 0.0));
-      if (!mixed) {
-        if (c0 < 0.0) {
-          const glm::dvec3 D = bakedDirectIrradiance(layer, map.texelCenter(i, j), normal);
-          for (int k = 0; k < 3; ++k) rgba[4 * t + static_cast<std::size_t>(k)] += static_cast<float>(D[k]);
-        }
-        continue;
-      }
-      // 8×8 points of the texel, each at offset (a, b) ∈ (−½, ½)² from its centre: the bilinear c
-      // between the centres around it, as the texture unit interpolates it.
-      int lit = 0;
-      for (int sb = 0; sb < 8; ++sb) {
-        for (int sa = 0; sa < 8; ++sa) {
-          const double a = (sa + 0.5) / 8.0 - 0.5, b = (sb + 0.5) / 8.0 - 0.5;
-          const int ia = a < 0.0 ? i - 1 : i, jb = b < 0.0 ? j - 1 : j;
-          const double fx = a < 0.0 ? 1.0 + a : a, fy = b < 0.0 ? 1.0 + b : b;
-          const double v = (1 - fx) * (1 - fy) * c(ia, jb) + fx * (1 - fy) * c(ia + 1, jb) +
-                           (1 - fx) * fy * c(ia, jb + 1) + fx * fy * c(ia + 1, jb + 1);
-          lit += v >= 0.0;
-        }
-      }
-      const double s = lit / 64.0;
-      const glm::dvec3 D = bakedDirectIrradiance(layer, map.texelCenter(i, j), normal);
-      for (int k = 0; k < 3; ++k) rgba[4 * t + static_cast<std::size_t>(k)] += static_cast<float>(D[k] * (1.0 - s));
     }
-  }, 16);
+    return lit / 64.0;
+  };
+  const glm::dvec3 normal = glm::cross(map.u, map.v);
+  std::vector<float> rgba(4 * n);
+  parallelFor(
+      0, ny,
+      [&](std::int64_t row) {
+        const int j = static_cast<int>(row);
+        for (int i = 0; i < nx; ++i) {
+          const std::size_t t = static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i);
+          float* out = &rgba[4 * t];
+          for (int k = 0; k < 3; ++k) out[k] = map.irradiance[3 * t + static_cast<std::size_t>(k)];
+          out[3] = edges ? clearance[t] : 1.0f;
+          const double shaded = edges ? 1.0 - litFraction(i, j) : 0.0;
+          if (shaded <= 0.0) continue;
+          const glm::dvec3 D = bakedDirectIrradiance(layer, map.texelCenter(i, j), normal);
+          for (int k = 0; k < 3; ++k) out[k] += static_cast<float>(D[k] * shaded);
+        }
+      },
+      16);
   return rgba;
 }
 
