@@ -8,6 +8,15 @@ function(eikonal_warnings target)
   endif()
 endfunction()
 
+# eikonal_use_allocator(TARGET): an executable gets the programs' allocator (core/allocator.cpp:
+# jemalloc, huge pages on) unless EIKONAL_JEMALLOC is off (sanitizer and fuzz builds).
+function(eikonal_use_allocator target)
+  if(EIKONAL_JEMALLOC)
+    target_sources(${target} PRIVATE ${PROJECT_SOURCE_DIR}/core/allocator.cpp)
+    target_link_libraries(${target} PRIVATE PkgConfig::JEMALLOC)
+  endif()
+endfunction()
+
 # eikonal_add_tests(NAME SOURCES a_test.cpp ... [SUPPORT helper.cpp ...] LIBS lib ...): one gtest
 # executable per folder, from the tests listed (x_test.cpp beside x.cpp) and any test-only support
 # sources, which thereby stay out of the product libraries.
@@ -19,6 +28,7 @@ function(eikonal_add_tests name)
   add_executable(${name} ${ARG_SOURCES} ${ARG_SUPPORT})
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest eikonal_test_main)
   eikonal_warnings(${name})
+  eikonal_use_allocator(${name})
   target_compile_definitions(${name} PRIVATE EIKONAL_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
                                               EIKONAL_BINARY_DIR="${PROJECT_BINARY_DIR}")
   gtest_discover_tests(${name} WORKING_DIRECTORY ${PROJECT_BINARY_DIR} DISCOVERY_TIMEOUT 60

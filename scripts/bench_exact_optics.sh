@@ -119,16 +119,12 @@ eikonal() {  # $1 resolution, $2 sharp|smooth
   local res=$1 mode=$2 name="sphere$1_$2" t vox bake render
   run_log="$out/logs/$name.log"
   : >"$run_log"
-  log "Eikonal $res³ $mode: voxelize"
-  t=$(now)
-  "$voxelize" procedural:sphere,r=1,center=0:1.5:0,ior=1.5 -o "$out/$name.vol.json" --res "$res" --pad 2 \
-    --interfaces "$mode" >>"$run_log" 2>&1
-  vox=$(since "$t")
-  log "Eikonal $res³ $mode: bake"
-  t=$(now)
-  "$lightsim" "$out/$name.vol.json" -o "$out/$name.baked.vol.json" --scene "$out/bake_scene.json" \
-    --stats "$out/$name.bake_stats.json" >>"$run_log" 2>&1
-  bake=$(since "$t")
+  log "Eikonal $res³ $mode: voxelize ($repeats×)"
+  vox=$(timed "$voxelize" procedural:sphere,r=1,center=0:1.5:0,ior=1.5 -o "$out/$name.vol.json" --res "$res" \
+    --pad 2 --interfaces "$mode")
+  log "Eikonal $res³ $mode: bake ($repeats×)"
+  bake=$(timed "$lightsim" "$out/$name.vol.json" -o "$out/$name.baked.vol.json" --scene "$out/bake_scene.json" \
+    --stats "$out/$name.bake_stats.json")
   view_scene "$name.baked.vol.json" >"$out/$name.view.json"
   log "Eikonal $res³ $mode: render ($repeats×)"
   render=$(timed "$viewer" "$out/$name.view.json" --render "$out/$name.floor.exr" --size "${width}x$height")
@@ -205,7 +201,7 @@ cpu=$(awk -F': ' '/model name/ { print $2; exit }' /proc/cpuinfo)
   echo "Machine: $(uname -m), $(nproc) cores, ${cpu:-unknown CPU}; viewer on llvmpipe (2 cores); POV-Ray +WT2."
   echo "Camera (viewer and POV-Ray): eye ($eye), target ($target), fov_y $fov_y°, ${width}x$height, 1 ray/pixel."
   echo "Exact row: E in W/m², Φ in W. Other rows: ratio to exact per ring, deviation of Φ, shadow radius."
-  echo "Times: median of $repeats runs for the renders, one run for voxelize and bake (wall seconds)."
+  echo "Times: median of $repeats runs of each command (wall seconds)."
   echo "Image rows (viewer, POV-Ray) point-sample the floor once per pixel (footprint about 0.011 x 0.025 near"
   echo "the caustic), which undersamples its core (a quarter of the flux of the ring 0-0.1 lies within r < 0.01):"
   echo "their ring 0-0.1 and Φ measure the camera's sampling as much as the renderer. The mean deviation"
