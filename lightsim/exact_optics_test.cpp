@@ -124,7 +124,8 @@ SphereBake bakeSphereOnFloor(int res, Stepping stepping = Stepping::Flight, Back
   const std::unique_ptr<Simulator> sim = simulatorFor(volume, backend);
   LightSpec light;  // straight down, irradiance 1
   SimulationOptions options;
-  options.max_depth = 4;  // lightsim's default with sharp interfaces
+  options.max_depth = volumeDefaults(true).max_depth;  // lightsim's defaults with sharp interfaces
+  options.split_voxels = volumeDefaults(true).split_voxels;
   options.free_flight = stepping != Stepping::Dt;  // lightsim's default: on
   if (stepping == Stepping::Straight) {
     options.volume_deposits = false;
@@ -230,17 +231,20 @@ TEST(ExactOpticsSphere, FreeFlightBakesTheSameCausticInFewerSteps) {
 // the finer grid.
 void expectConvergesToExactOptics(const SphereBake& coarse, const SphereBake& fine) {
   const reference::ReceiverTally& exact = exactSphereOnFloor();
-  // The bound at 64³ is 10 % mean deviation (5 % at 128³); 48³ is measured at 2.8 %, 32³
-  // at 5.5 %. The error must fall with resolution: the discretisation converges.
+  // The bound at 64³ is 10 % mean deviation (5 % at 128³); 48³ is measured at 2.4 %, 32³
+  // at 5.1 % (lightsim's defaults: splits past 1.5 voxels, depth 4). The error must fall with
+  // resolution: the discretisation converges.
   EXPECT_LT(fine.mean_deviation, 0.10);
   EXPECT_LT(fine.mean_deviation, coarse.mean_deviation);
-  EXPECT_LT(fine.worst_deviation, 0.2);  // the dim ring 0.9–1.0 (E ≈ 0.05): 10.5 % at 48³
+  EXPECT_LT(fine.worst_deviation, 0.2);  // the dim ring 0.9–1.0 (E ≈ 0.05): 6.4 % at 48³
   // Against the exact answer measured through the same texels: the bounds at 128³ are 5 %
-  // mean and 10 % in every ring (BENCHMARKS.md); at 48³ measured 2.9 % and 12.8 % (the ring
-  // 0.9–1.0, where the bake's shadow edge, 0.07 % wide of r = 1, lets less of the bright floor into
-  // texels centred inside it).
+  // mean and 10 % in every ring (BENCHMARKS.md; measured 2.2 % and 5.5 %); at 48³ measured 3.3–3.4 %
+  // and 15.8–16.3 % (the ring 0.9–1.0, where the bake's shadow edge, 0.07 % wide of r = 1, lets less of
+  // the bright floor into texels centred inside it; the patches torn at the silhouette at the depth
+  // limit die there). Splitting past 1.5 voxels instead of 1 moved that ring from 12.8 to 15.8 %
+  // of the texel-binned answer and from 10.0 to 6.4 % of the exact one; 17 % holds it to that.
   EXPECT_LT(fine.mean_vs_texels, 0.05);
-  EXPECT_LT(fine.worst_vs_texels, 0.15);
+  EXPECT_LT(fine.worst_vs_texels, 0.17);
   // The shadow's edge stays at the sphere's radius (the smoothed boundary put it 8 % out):
   // ±0.01 is 0.24 voxel at 48³.
   EXPECT_NEAR(fine.rings.shadow_radius, 1.0, 0.01);
@@ -293,8 +297,8 @@ TEST(ExactOpticsSphere, TheGpuPathFliesAndTakesStraightStepsAsTheTwinDoes) {
   const SphereBake gpu = bakeSphereOnFloor(48, Stepping::Straight, Backend::Gl);
   EXPECT_EQ(gpu.stats.backend, "gl");
   // Float against double corners: where a patch splits or a flight ends moves by rounding, so the
-  // two bakes are not the same patch for patch. Measured at 48³: 8.0e-4 relative L2, 252 548
-  // against 253 103 patch-steps; 2 % more patch-steps would be a flight or straight step refused.
+  // two bakes are not the same patch for patch. Measured at 48³: 1.6e-3 relative L2, 153 947
+  // against 154 608 patch-steps; 2 % more patch-steps would be a flight or straight step refused.
   const double map = relativeL2(gpu.map.irradiance, cpu.map.irradiance);
   std::printf("GPU path against the twin, 48³: map %.2e relative L2; %llu against %llu patch-steps\n", map,
               static_cast<unsigned long long>(gpu.stats.total_patches),
@@ -304,7 +308,7 @@ TEST(ExactOpticsSphere, TheGpuPathFliesAndTakesStraightStepsAsTheTwinDoes) {
     EXPECT_NEAR(gpu.rings.irradiance[k] / cpu.rings.irradiance[k], 1.0, 0.01) << "ring " << k;
   EXPECT_NEAR(static_cast<double>(gpu.stats.total_patches), static_cast<double>(cpu.stats.total_patches),
               0.02 * static_cast<double>(cpu.stats.total_patches));
-  // The last patch alive may die a step earlier or later (measured: 43 against 42 steps).
+  // The last patch alive may die a step earlier or later (where it dies moves by rounding).
   EXPECT_NEAR(gpu.stats.steps, cpu.stats.steps, 2);
   expectConvergesToExactOptics(bakeSphereOnFloor(32, Stepping::Straight, Backend::Gl), gpu);
 }

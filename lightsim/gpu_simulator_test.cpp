@@ -290,7 +290,9 @@ TEST(GpuSimulatorTest, OverlappedCountReadbackBakesWhatWaitingForEveryCountDoes)
       EXPECT_GT(oInfo.waited_counts, 1);                 // the bound did not fit
       EXPECT_LT(oInfo.waited_counts, wInfo.waited_counts);  // but mostly it did
     }
-    if (run.options.max_steps > 0) EXPECT_GT(luminance(w.stats.flux_unfinished), 0.0);
+    if (run.options.max_steps > 0) {
+      EXPECT_GT(luminance(w.stats.flux_unfinished), 0.0);
+    }
     EXPECT_EQ(o.irradiance.data, w.irradiance.data);
     EXPECT_EQ(o.light_dir.data, w.light_dir.data);
     ASSERT_EQ(o.receivers.size(), 1u);

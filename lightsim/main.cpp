@@ -101,8 +101,11 @@ int run(int argc, char** argv) {
   app.add_option("--step", options.step_voxels, "time step: arc length per step in air, in voxels (default 0.5)")
       ->check(CLI::Range(0.01, 4.0));
   app.add_option("--patch", options.patch_voxels, "initial patch edge in voxels (default 1)")->check(CLI::Range(0.05, 8.0));
-  app.add_option("--split", options.split_voxels, "split patches with an edge longer than this, in voxels (default 1)")
-      ->check(CLI::Range(0.1, 16.0));
+  CLI::Option* split =
+      app.add_option("--split", options.split_voxels,
+                     "split patches with an edge longer than this, in voxels (default 1.5 for a volume with sharp "
+                     "interfaces, 1 for a smoothed one)")
+          ->check(CLI::Range(0.1, 16.0));
   app.add_option("--split-rule", split_rule,
                  "axis (default: halve only the directions whose edges are too long, 1x2 or 2x2) or quad "
                  "(the thesis: always 2x2)")
@@ -174,7 +177,9 @@ int run(int argc, char** argv) {
   Volume volume = readVolume(input);
   volume.require("ior", 1, input);
   volume.require("ior_grad", 3, input);
-  if (max_depth->count() == 0) options.max_depth = volume.has("interfaces") ? 4 : 6;
+  const VolumeDefaults defaults = volumeDefaults(volume.has("interfaces"));
+  if (max_depth->count() == 0) options.max_depth = defaults.max_depth;
+  if (split->count() == 0) options.split_voxels = defaults.split_voxels;
   options.volume_deposits = volume_deposits == "on" ||
                             (volume_deposits == "auto" && viewerReadsVolumeLight(volume, options.receiver.has_value()));
   if (!options.volume_deposits && !options.receiver)

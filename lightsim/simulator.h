@@ -69,11 +69,11 @@ struct SimulationOptions {
   Integrator integrator = Integrator::Euler;
   double step_voxels = 0.5;       // Δt = step_voxels·h: the arc length per step in air, in voxels
   double patch_voxels = 1.0;      // initial patch edge, at most this many voxels
-  double split_voxels = 1.0;      // split a patch whose longest edge exceeds this many voxels
+  double split_voxels = 1.0;      // split a patch whose longest edge exceeds this many voxels (volumeDefaults)
   SplitRule split_rule = SplitRule::Axis;  // Axis: halve only the long direction (1×2); Quad: 2×2 (thesis)
   // Splits allowed per initial patch (a 1×2 split counts ½). `lightsim` takes 4 for a volume with
   // sharp interfaces (measured on the glass sphere: more accurate on the ground and 5–7× faster
-  // than 6, whose extra slivers only tear at the silhouette) and 6 for a smoothed one.
+  // than 6, whose extra slivers only tear at the silhouette) and 6 for a smoothed one (volumeDefaults).
   int max_depth = 6;
   // At max_depth a patch that should split is kept unsplit (Keep, default: its flux goes on and is
   // deposited at its midpoint) or killed (Kill, the thesis §6.2.4; its flux is lost).
@@ -105,6 +105,22 @@ struct SimulationOptions {
   // run stops at its next step and throws BakeCancelled. Null: never cancelled.
   const std::atomic<bool>* cancel = nullptr;
 };
+
+// What `lightsim` takes, unless told otherwise, for a volume with sharp interfaces or a smoothed n
+// (its gradient field), and so the viewer's re-bake of a bake that does not record its options and
+// the tests that bake as `lightsim` does. With sharp interfaces a patch splits once an edge is past
+// 1.5 voxels, at most 4 times: between interfaces the rays are straight and the footprint deposits
+// need no finer wavefront, so the 128³ glass sphere bakes in 0.89 M patch-steps instead of 1.54 M
+// (split at 1 voxel) with its floor as close to exact optics (BENCHMARKS.md "Patches split at 1.5
+// voxels"); the silhouette's tears still split to a sixteenth of a voxel. A smoothed n bends
+// every ray: 1 voxel, 6 times.
+struct VolumeDefaults {
+  double split_voxels = 1.0;
+  int max_depth = 6;
+};
+inline VolumeDefaults volumeDefaults(bool sharp_interfaces) {
+  return sharp_interfaces ? VolumeDefaults{1.5, 4} : VolumeDefaults{1.0, 6};
+}
 
 // What Simulator::run throws when SimulationOptions::cancel was set: the bake was abandoned.
 struct BakeCancelled : std::runtime_error {

@@ -18,7 +18,8 @@ constexpr int kBallRes = 32;
 
 inline SimulationOptions lightsimOptions() {
   SimulationOptions options;
-  options.max_depth = 4;       // lightsim's default with sharp interfaces
+  options.max_depth = volumeDefaults(true).max_depth;  // lightsim's defaults with sharp interfaces
+  options.split_voxels = volumeDefaults(true).split_voxels;
   options.free_flight = true;  // lightsim's default
   ReceiverSpec floor;
   floor.half_extent = 1.6;
