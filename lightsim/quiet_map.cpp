@@ -96,7 +96,7 @@ QuietMap::QuietMap(const GridSpec& grid, const std::vector<std::uint8_t>& flagge
 void QuietMap::chooseBricks() {
   const glm::ivec3 d = grid_.dims;
   const int longest = std::max(d.x, std::max(d.y, d.z));
-  brick_ = longest <= 160 ? 1 : longest <= 512 ? 2 : 4;
+  brick_ = longest <= 100 ? 1 : longest <= 512 ? 2 : 4;
   brick_shift_ = brick_ == 1 ? 0 : brick_ == 2 ? 1 : 2;
   inv_voxel_size_ = 1.0 / grid_.voxelSize();
   bricks_ = (d + (brick_ - 1)) / brick_;

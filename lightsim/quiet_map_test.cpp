@@ -221,7 +221,7 @@ TEST(QuietMap, EveryBoxIsQuietExactlyWhenNoFlaggedBrickIsInIt) {
     for (int i = 0; i < flagged; ++i) flags[grid.index(voxel(rng), voxel(rng), voxel(rng))] = 1;
     const QuietMap map(grid, flags);
     const int brick = map.brickVoxels();
-    EXPECT_EQ(brick, n <= 160 ? 1 : 2);
+    EXPECT_EQ(brick, n <= 100 ? 1 : 2);
     std::vector<std::uint8_t> brick_flag(static_cast<std::size_t>(map.bricks().x) * map.bricks().y * map.bricks().z, 0);
     for (int z = 0; z < n; ++z)
       for (int y = 0; y < n; ++y)
