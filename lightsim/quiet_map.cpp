@@ -28,8 +28,8 @@ QuietMap::QuietMap(const GridSpec& grid, const std::vector<glm::vec4>& ior_grad,
     : grid_(grid) {
   const glm::ivec3 d = grid.dims;
   if (d.x <= 0 || d.y <= 0 || d.z <= 0 || ior_grad.size() != grid.count()) return;
-  chooseBricks();
   const bool sharp = !table.empty() && distances.size() == grid.count();
+  chooseBricks(sharp ? 100 : 160);
   const int slots = sharp ? static_cast<int>(table.slots.size()) : 0;
   auto signature = [&](std::size_t v) {
     Signature s;
@@ -84,7 +84,7 @@ QuietMap::QuietMap(const GridSpec& grid, const std::vector<glm::vec4>& ior_grad,
 QuietMap::QuietMap(const GridSpec& grid, const std::vector<std::uint8_t>& flagged_voxels) : grid_(grid) {
   const glm::ivec3 d = grid.dims;
   if (d.x <= 0 || d.y <= 0 || d.z <= 0 || flagged_voxels.size() != grid.count()) return;
-  chooseBricks();
+  chooseBricks(160);
   std::vector<std::uint8_t> flag(static_cast<std::size_t>(bricks_.x) * bricks_.y * bricks_.z, 0);
   for (int z = 0; z < d.z; ++z)
     for (int y = 0; y < d.y; ++y)
@@ -93,10 +93,10 @@ QuietMap::QuietMap(const GridSpec& grid, const std::vector<std::uint8_t>& flagge
   buildTable(flag);
 }
 
-void QuietMap::chooseBricks() {
+void QuietMap::chooseBricks(int per_voxel_up_to) {
   const glm::ivec3 d = grid_.dims;
   const int longest = std::max(d.x, std::max(d.y, d.z));
-  brick_ = longest <= 100 ? 1 : longest <= 512 ? 2 : 4;
+  brick_ = longest <= per_voxel_up_to ? 1 : longest <= 512 ? 2 : 4;
   brick_shift_ = brick_ == 1 ? 0 : brick_ == 2 ? 1 : 2;
   inv_voxel_size_ = 1.0 / grid_.voxelSize();
   bricks_ = (d + (brick_ - 1)) / brick_;

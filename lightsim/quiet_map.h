@@ -6,10 +6,12 @@
 // rate constant, so a patch can cross the region in one step of any length and its track deposits
 // (track_deposit.h, exact along straight sub-paths) do not change.
 //
-// The map keeps one flag per brick of b³ voxels (b = 1 up to 100 voxels an axis, 2 up to 512, 4
-// beyond, so that the table stays under 32 M entries; at 132³ bricks of 2³ build in 0.04 s instead
-// of 0.13 and answer from a table that stays in cache, which outweighs the 16 % more patch-steps
-// of their coarser band: BENCHMARKS.md "Patches split at 1.5 voxels"): noisy when a voxel in it is noisy itself
+// The map keeps one flag per brick of b³ voxels (b = 1 up to 100 voxels an axis with sharp
+// interfaces, up to 160 otherwise; 2 up to 512, 4 beyond, so that the table stays under 32 M
+// entries). At 132³ with sharp interfaces bricks of 2³ build in 0.04 s instead of 0.13 and answer
+// from tables that stay in cache, which outweighs the 16 % more patch-steps of their coarser band;
+// a smoothed n's wide band of ∇n ≠ 0 takes 9 % more patch-steps and 11 % more time per brick
+// (BENCHMARKS.md "Patches split at 1.5 voxels"). Noisy when a voxel in it is noisy itself
 // (∇n ≠ 0, a distance exactly 0, a graded material) or differs from a face neighbour, in which
 // case both bricks are noisy. A box of voxels without a noisy brick holds one signature (it is
 // connected through face neighbours, none of which differ), and a summed-area table over the flags
@@ -71,8 +73,9 @@ class QuietMap {
   // noisy brick, at most 255 (also where none is noisy).
   std::vector<std::uint8_t> clearance_;
   void buildClearance(const std::vector<std::uint8_t>& brick_flags);
-  // The brick size for the grid, and the summed-area table over per-brick flags.
-  void chooseBricks();
+  // The brick size for the grid (1 voxel up to `per_voxel_up_to` voxels an axis, then 2 up to 512,
+  // then 4), and the summed-area table over per-brick flags.
+  void chooseBricks(int per_voxel_up_to);
   std::vector<std::uint8_t>::reference brickFlag(std::vector<std::uint8_t>& flags, int x, int y, int z) const;
   void buildTable(const std::vector<std::uint8_t>& brick_flags);
   std::uint32_t sat(int i, int j, int k) const {

@@ -111,6 +111,26 @@ TEST(QuietMap, AbsorptionEdgesAreNotQuietAndUniformAbsorptionIs) {
   EXPECT_TRUE(all.quiet(glm::dvec3(-0.5), glm::dvec3(0.5)));
 }
 
+// The brick size: with sharp interfaces a flag per voxel up to 100 voxels an axis, bricks of 2³
+// beyond (the 128³ sphere's 132³ grid: a cheaper map whose tables stay in cache); without them
+// (a smoothed n, whose band of ∇n ≠ 0 is wide) per voxel up to 160.
+TEST(QuietMap, SharpVolumesTakeBricksFromAHundredVoxels) {
+  for (const int n : {100, 101}) {
+    const GridSpec grid = boxGrid({n, 4, 4}, 0.01);
+    const std::vector<glm::vec4> ior_grad(grid.count(), glm::vec4(1.0f, 0.0f, 0.0f, 0.0f));
+    const std::vector<glm::vec4> distances(grid.count(), glm::vec4(1.0f));
+    InterfaceTable table;
+    table.slots.resize(1);
+    table.band = 0.04;
+    const QuietMap sharp(grid, ior_grad, distances, table, {});
+    const QuietMap smooth(grid, ior_grad, {}, InterfaceTable{}, {});
+    EXPECT_EQ(sharp.brickVoxels(), n <= 100 ? 1 : 2) << n;
+    EXPECT_EQ(smooth.brickVoxels(), 1) << n;
+    EXPECT_EQ(sharp.noisyBricks(), 0u);
+    EXPECT_TRUE(sharp.quiet(grid.bounds_min, grid.bounds_max));
+  }
+}
+
 // From flagged voxels (VolumeSampler::absorberMap): a box is quiet exactly when no trilinear sample
 // in it takes a flagged voxel as one of its eight taps (taps floor(q − ½) and the next, at voxel
 // coordinate q; 8³ voxels of 1/8, so brick = voxel); an absorbing sphere's map is not quiet at it.
@@ -221,7 +241,7 @@ TEST(QuietMap, EveryBoxIsQuietExactlyWhenNoFlaggedBrickIsInIt) {
     for (int i = 0; i < flagged; ++i) flags[grid.index(voxel(rng), voxel(rng), voxel(rng))] = 1;
     const QuietMap map(grid, flags);
     const int brick = map.brickVoxels();
-    EXPECT_EQ(brick, n <= 100 ? 1 : 2);
+    EXPECT_EQ(brick, n <= 160 ? 1 : 2);  // flags of the voxels (absorbers): per voxel up to 160
     std::vector<std::uint8_t> brick_flag(static_cast<std::size_t>(map.bricks().x) * map.bricks().y * map.bricks().z, 0);
     for (int z = 0; z < n; ++z)
       for (int y = 0; y < n; ++y)
