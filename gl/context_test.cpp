@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <dlfcn.h>
+
 #include <cstdio>
 #include <cstdlib>
 
@@ -74,6 +76,23 @@ TEST(OSMesaContext, RendersPatternPixelExact) {
   EXPECT_FALSE(context.isWindow());
   EXPECT_EQ(context.window(), nullptr);
   test::renderAndCheckPattern(96, 64);
+}
+
+// libOSMesa (and the LLVM it loads) is opened only when an OSMesa context is made: the CPU twin and
+// EGL never load it (context_osmesa.cpp). ctest runs each test in a process of its own, so nothing
+// has made a context before this test starts.
+TEST(OSMesaContext, LibraryIsLoadedOnlyWhenAnOSMesaContextIsMade) {
+  auto loaded = [] {
+    void* handle = dlopen("libOSMesa.so.8", RTLD_NOW | RTLD_NOLOAD);
+    if (handle) dlclose(handle);  // drops only the reference RTLD_NOLOAD took
+    return handle != nullptr;
+  };
+  if (::testing::UnitTest::GetInstance()->test_to_run_count() != 1) {
+    GTEST_SKIP() << "needs a process of its own (ctest runs it so): other tests make OSMesa contexts";
+  }
+  EXPECT_FALSE(loaded()) << "libOSMesa.so.8 was loaded before any context was made (linked, not opened)";
+  GlContext context(ContextOptions{.backend = GlBackend::OSMesa});
+  EXPECT_TRUE(loaded());
 }
 
 TEST(EglContext, RendersPatternPixelExact) {

@@ -20,10 +20,16 @@
 # misses the sphere grown to 1.05 (the camera sits low to the side, so it sees the floor under the
 # sphere below it; ring_compare reports the fraction of each ring it sees).
 #
-# Usage: scripts/bench_exact_optics.sh [--out DIR] [--quick] [--build DIR]
-#   --out DIR    outputs (volumes, images, JSON, logs, table.md); default BUILD/bench-exact-optics
-#   --quick      N = 32 and 64, 10⁶ tracer rays, one POV-Ray photon count, one run each (a test)
-#   --build DIR  the build tree with voxelize, lightsim, viewer and tests/ring_compare (default build)
+# Usage: scripts/bench_exact_optics.sh [--out DIR] [--quick] [--build DIR] [--res "N..."]
+#                                      [--backend auto|gl|cpu] [--no-pov] [--exact FILE]
+#   --out DIR      outputs (volumes, images, JSON, logs, table.md); default BUILD/bench-exact-optics
+#   --quick        N = 32 and 64, 10⁶ tracer rays, one POV-Ray photon count, one run each (a test)
+#   --build DIR    the build tree with voxelize, lightsim, viewer and tests/ring_compare (default build)
+#   --res "N..."   Eikonal's grids (default "64 128"; the smoothed-interface row uses the last)
+#   --backend B    lightsim's back end (default auto: the GPU path on a GPU, the CPU twin on llvmpipe);
+#                  on a GPU server without a display, EIKONAL_GL=egl picks the OpenGL back end
+#   --no-pov       leave POV-Ray out (a machine without it)
+#   --exact FILE   the exact tracer's JSON of an earlier run instead of tracing again
 # Needs the benchmark tool: cmake --build build --target ring_compare (EIKONAL_BUILD_BENCHMARKS and
 # EIKONAL_BUILD_TESTS on). Installs the Debian package povray when `povray` is missing (as root).
 # Prints the Markdown table on stdout (also OUT/table.md); progress goes to stderr.
@@ -31,12 +37,16 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build="$root/build"
 out=""
-quick=0
+quick=0 res_option="" backend=auto pov=1 exact_file=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --out) out=$2; shift 2 ;;
     --quick) quick=1; shift ;;
     --build) build=$2; shift 2 ;;
+    --res) res_option=$2; shift 2 ;;
+    --backend) backend=$2; shift 2 ;;
+    --no-pov) pov=0; shift ;;
+    --exact) exact_file=$(cd "$(dirname "$2")" && pwd)/$(basename "$2"); shift 2 ;;
     -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
     *) echo "bench_exact_optics.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
   esac
@@ -51,6 +61,8 @@ if [ "$quick" = 1 ]; then
 else
   resolutions="64 128"; rays=2e7; pov_counts="100000 200000 400000 1600000"; repeats=3
 fi
+resolutions=${res_option:-$resolutions}
+[ "$pov" = 1 ] || pov_counts=""
 smooth_res=${resolutions##* }
 # The camera of the viewer and of POV-Ray: low, to the side, looking at the caustic's centre.
 eye="0,2.4,4.8"; target="0,0,0"; fov_y=36; width=256; height=256
@@ -67,7 +79,7 @@ done
 mkdir -p "$out/bin"
 cp "$voxelize" "$lightsim" "$viewer" "$ring_compare" "$out/bin/"
 voxelize="$out/bin/voxelize" lightsim="$out/bin/lightsim" viewer="$out/bin/viewer" ring_compare="$out/bin/ring_compare"
-if ! command -v povray >/dev/null; then
+if [ "$pov" = 1 ] && ! command -v povray >/dev/null; then
   echo "bench_exact_optics.sh: installing povray (Debian package)" >&2
   DEBIAN_FRONTEND=noninteractive apt-get install -y povray >"$out/logs/apt-povray.log" 2>&1 ||
     { echo "bench_exact_optics.sh: apt-get install povray failed (see $out/logs/apt-povray.log)" >&2; exit 2; }
@@ -110,8 +122,12 @@ EOF
 log "exact tracer: $rays rays"
 rays_text=$(awk -v r="$rays" 'BEGIN { e = int(log(r) / log(10) + 1e-9); m = r / 10 ^ e;
   if (m == 1) printf "10^%d", e; else printf "%g·10^%d", m, e }')
-"$ring_compare" trace -o "$out/exact.json" --rays "$rays" --label "exact tracer ($rays_text rays)" \
-  >"$out/logs/exact.log" 2>&1
+if [ -n "$exact_file" ]; then
+  [ "$exact_file" = "$out/exact.json" ] || cp "$exact_file" "$out/exact.json"
+else
+  "$ring_compare" trace -o "$out/exact.json" --rays "$rays" --label "exact tracer ($rays_text rays)" \
+    >"$out/logs/exact.log" 2>&1
+fi
 results=("$out/exact.json")
 
 # --- 2. Eikonal --------------------------------------------------------------------------------
@@ -124,7 +140,7 @@ eikonal() {  # $1 resolution, $2 sharp|smooth
     --pad 2 --interfaces "$mode")
   log "Eikonal $res³ $mode: bake ($repeats×)"
   bake=$(timed "$lightsim" "$out/$name.vol.json" -o "$out/$name.baked.vol.json" --scene "$out/bake_scene.json" \
-    --stats "$out/$name.bake_stats.json")
+    --backend "$backend" --stats "$out/$name.bake_stats.json")
   view_scene "$name.baked.vol.json" >"$out/$name.view.json"
   log "Eikonal $res³ $mode: render ($repeats×)"
   render=$(timed "$viewer" "$out/$name.view.json" --render "$out/$name.floor.exr" --size "${width}x$height")
@@ -178,7 +194,7 @@ sphere { <0, 1.5, 0>, 1
 plane { y, 0 pigment { rgb 0.8 } finish { ambient 0 diffuse 1 } }
 EOF
 }
-pov_version=$(povray --version 2>&1 | grep -m1 -o 'POV-Ray [0-9.]*[a-z.]*' || echo POV-Ray)
+[ "$pov" = 0 ] || pov_version=$(povray --version 2>&1 | grep -m1 -o 'POV-Ray [0-9.]*[a-z.]*' || echo POV-Ray)
 for count in $pov_counts; do
   name="pov_$count"
   run_log="$out/logs/$name.log"
@@ -198,7 +214,10 @@ done
 # --- 4. the table --------------------------------------------------------------------------------
 cpu=$(awk -F': ' '/model name/ { print $2; exit }' /proc/cpuinfo)
 {
-  echo "Machine: $(uname -m), $(nproc) cores, ${cpu:-unknown CPU}; viewer on llvmpipe (2 cores); POV-Ray +WT2."
+  bake_renderer=$(/usr/bin/env python3 -c "import json, sys; print(json.load(open(sys.argv[1]))['renderer'])" \
+    "$out/sphere${resolutions##* }_sharp.bake_stats.json" 2>/dev/null || echo "?")
+  echo "Machine: $(uname -m), $(nproc) cores, ${cpu:-unknown CPU}; bake: $bake_renderer;" \
+    "viewer: ${EIKONAL_GL:-auto} OpenGL (llvmpipe unless a GPU's EGL is picked); POV-Ray +WT2."
   echo "Camera (viewer and POV-Ray): eye ($eye), target ($target), fov_y $fov_y°, ${width}x$height, 1 ray/pixel."
   echo "Exact row: E in W/m², Φ in W. Other rows: ratio to exact per ring, deviation of Φ, shadow radius."
   echo "Times: median of $repeats runs of each command (wall seconds)."
