@@ -42,15 +42,14 @@ bool lookUp(void* handle, const char* name, F& function, std::string& error) {
 const OSMesaLibrary& osmesaLibrary() {
   static const OSMesaLibrary library = [] {
     OSMesaLibrary l;
-    void* handle = nullptr;
-    for (const char* name : {"libOSMesa.so.8", "libOSMesa.so"}) {
-      if ((handle = dlopen(name, RTLD_NOW | RTLD_LOCAL))) break;
-    }
+    void* handle = dlopen("libOSMesa.so.8", RTLD_NOW | RTLD_LOCAL);
     if (!handle) {
-      const char* why = dlerror();
+      const char* why = dlerror();  // the versioned name's reason, the one a user can act on
       l.error = std::string("libOSMesa.so.8 could not be loaded (") + (why ? why : "not found") +
                 "; Debian: apt-get install libosmesa6, or use EIKONAL_GL=egl)";
-      return l;
+      handle = dlopen("libOSMesa.so", RTLD_NOW | RTLD_LOCAL);  // a development symlink only
+      if (!handle) return l;
+      l.error.clear();
     }
     lookUp(handle, "OSMesaCreateContextAttribs", l.createContextAttribs, l.error);
     lookUp(handle, "OSMesaMakeCurrent", l.makeCurrent, l.error);

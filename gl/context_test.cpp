@@ -163,7 +163,7 @@ TEST(GlContextTest, TwoBackEndsInOneProcess) {
 }
 
 TEST(GlContextTest, DebugChecksTurnGlErrorsIntoExceptions) {
-  GlContext context(ContextOptions{.backend = GlBackend::OSMesa, .debug = true});
+  GlContext context(ContextOptions{.backend = glBackendFromEnvironment(GlBackend::OSMesa), .debug = true});
   EXPECT_TRUE(context.debug());
   EXPECT_TRUE(errorChecksEnabled());
   EXPECT_TRUE(context.info().debugOutput) << "Mesa offers KHR_debug";
@@ -180,7 +180,7 @@ TEST(GlContextTest, DebugChecksTurnGlErrorsIntoExceptions) {
 }
 
 TEST(GlContextTest, NoChecksWithoutDebug) {
-  GlContext context(ContextOptions{.backend = GlBackend::OSMesa, .debug = false});
+  GlContext context(ContextOptions{.backend = glBackendFromEnvironment(GlBackend::OSMesa), .debug = false});
   EXPECT_FALSE(errorChecksEnabled());
   glBindTexture(GL_TEXTURE_2D, 987654u);
   EXPECT_NO_THROW(checkErrors("unchecked"));

@@ -20,7 +20,7 @@ namespace {
 class GlObjects : public ::testing::Test {
  protected:
   // Error checks on whatever the build type: every wrapper call is followed by a check.
-  GlContext context_{ContextOptions{.backend = GlBackend::OSMesa, .debug = true}};
+  GlContext context_{ContextOptions{.backend = glBackendFromEnvironment(GlBackend::OSMesa), .debug = true}};
 };
 
 GLint getInt(GLenum name) {
@@ -79,7 +79,7 @@ TEST_F(GlObjects, MovedFromObjectsAreEmptyAndDeleteNothing) {
 TEST_F(GlObjects, ObjectsOutlivingTheirContextDeleteNothing) {
   Texture2D survivor;
   {
-    GlContext other(ContextOptions{.backend = GlBackend::OSMesa});
+    GlContext other(ContextOptions{.backend = glBackendFromEnvironment(GlBackend::OSMesa)});
     survivor = Texture2D({2, 2}, TextureFormat::R8);
   }
   // `other` is gone and nothing is current: the destructor must not call into GL.

@@ -14,7 +14,7 @@ namespace {
 
 class ScopedStateTest : public ::testing::Test {
  protected:
-  GlContext context_{ContextOptions{.backend = GlBackend::OSMesa, .debug = true}};
+  GlContext context_{ContextOptions{.backend = glBackendFromEnvironment(GlBackend::OSMesa), .debug = true}};
 };
 
 GLint integer(GLenum name) {

@@ -38,7 +38,7 @@ std::string compileError(const ShaderLibrary& library, const std::string& fragme
 
 class ShaderLibraryGl : public ::testing::Test {
  protected:
-  GlContext context_{ContextOptions{.backend = GlBackend::OSMesa, .debug = true}};
+  GlContext context_{ContextOptions{.backend = glBackendFromEnvironment(GlBackend::OSMesa), .debug = true}};
 };
 
 TEST(ShaderSourceTest, TranslatesMesaNvidiaAndAmdLogs) {

@@ -18,7 +18,7 @@ namespace {
 class TimeQueryTest : public ::testing::Test {
  protected:
   // Error checks on whatever the build type.
-  GlContext context_{ContextOptions{.backend = GlBackend::OSMesa, .debug = true}};
+  GlContext context_{ContextOptions{.backend = glBackendFromEnvironment(GlBackend::OSMesa), .debug = true}};
   Framebuffer target_{{64, 64}, {TextureFormat::RGBA32F}};
 
   // A little GPU work to time.

@@ -101,7 +101,7 @@ Volume makeVolume(glm::ivec3 dims, const Fields& fields, unsigned seed) {
 
 class VolumeTexturesGl : public ::testing::Test {
  protected:
-  GlContext context_{ContextOptions{.backend = GlBackend::OSMesa, .debug = true}};
+  GlContext context_{ContextOptions{.backend = glBackendFromEnvironment(GlBackend::OSMesa), .debug = true}};
 };
 
 // Samples every voxel centre through common/volume.glsl with PROBE(uvw) and compares with the

@@ -100,8 +100,9 @@ void expectAnalysisMatchesTheCpuTwin(DepositMode mode) {
   // voxel face into the other voxel: rarely.
   EXPECT_LE(fatesOff, static_cast<int>(count / 1000));
   EXPECT_LE(voxelsOff, static_cast<int>(count / 1000));
-  EXPECT_LT(worstAbsorbed, 1e-5);
-  EXPECT_LT(worstReflected, 1e-5);
+  // 1e-5 of the patch's flux on llvmpipe; NVIDIA's float arithmetic: 7.4e-5 (absorbed).
+  EXPECT_LT(worstAbsorbed, 1e-5 * test_scenes::gpuArithmeticSlack());
+  EXPECT_LT(worstReflected, 1e-5 * test_scenes::gpuArithmeticSlack());
 }
 
 TEST(AnalysisPassTest, AccumulateModeMatchesTheCpuTwinPatchForPatch) {

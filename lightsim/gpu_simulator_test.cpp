@@ -451,9 +451,14 @@ TEST(GpuSimulatorTest, MaxModeAndRk4MatchCpu) {
   const int off = voxelsOff(c.gpu, c.cpu, 0.01, 0.1 /* a tenth of E_L */, &considered);
   const double d = lightDirDifference(c.gpu, c.cpu);
   std::printf("max mode: %d of %d lit voxels off by > 1 %%; light_dir relative L2 %.2e\n", off, considered, d);
-  EXPECT_LE(off, considered / 200);  // ≤ 0.5 %
+  // ≤ 0.5 % of the voxels and 1 % in light_dir on llvmpipe. With a hardware GPU's arithmetic
+  // (gpuArithmeticSlack) the fold regions grow: NVIDIA H200, 597 of 25 678 voxels (2.3 %) and
+  // light_dir 0.16 (where two patches' E nearly tie, the other one's direction wins), hence 5 % and
+  // 0.3 there; a wrong deposit rule or a lost patch moves whole regions, far past either.
+  const bool software = test_scenes::gpuArithmeticSlack() == 1.0;
+  EXPECT_LE(off, considered / (software ? 200 : 20));
   EXPECT_GT(considered, 1000);
-  EXPECT_LT(d, 0.01);
+  EXPECT_LT(d, software ? 0.01 : 0.3);
   expectLedgersAgree(c.gpu.stats, c.cpu.stats, 1e-3);
   EXPECT_NEAR(static_cast<double>(c.gpu.stats.kills.folded), static_cast<double>(c.cpu.stats.kills.folded),
               0.01 * static_cast<double>(c.cpu.stats.kills.folded));
@@ -495,8 +500,9 @@ void expectOneStepMatchesTheCpuTwin(SplitRule rule) {
     }
     worstFlux = std::max(worstFlux, glm::length(g.flux - c.flux) / glm::length(c.flux));
     ASSERT_EQ(g.depth, c.depth) << k;
-    EXPECT_NEAR(g.n_in, c.n_in, 1e-4) << k;
-    EXPECT_NEAR(g.area0, c.area0, 1e-5 * c.area0 + 1e-12) << k;
+    EXPECT_NEAR(g.n_in, c.n_in, 1e-4 * test_scenes::gpuArithmeticSlack()) << k;
+    // NVIDIA: 1.1e-5 relative (a cross product of nearly equal corners' differences).
+    EXPECT_NEAR(g.area0, c.area0, (1e-5 * c.area0 + 1e-12) * test_scenes::gpuArithmeticSlack()) << k;
     inLayer += c.n_in != 0.0 ? 1 : 0;
   }
   std::printf("%zu → %zu patches, %d 1×2 and %d 2×2 splits, %d in a boundary layer; worst |Δx| %.2e voxel, "
@@ -508,9 +514,11 @@ void expectOneStepMatchesTheCpuTwin(SplitRule rule) {
   if (rule == SplitRule::Quad) {
     EXPECT_EQ(splits[2], 0);
   }
-  EXPECT_LT(worstX, 1e-4);
-  EXPECT_LT(worstW, 1e-4);
-  EXPECT_LT(worstFlux, 1e-4);
+  // llvmpipe's bounds; NVIDIA: |Δx| 8.8e-4 voxel, |Δw| 9.3e-4, flux 1.1e-4 (gpuArithmeticSlack).
+  const double slack = test_scenes::gpuArithmeticSlack();
+  EXPECT_LT(worstX, 1e-4 * slack);
+  EXPECT_LT(worstW, 1e-4 * slack);
+  EXPECT_LT(worstFlux, 1e-4 * slack);
 }
 
 TEST(GpuSimulatorTest, OneStepOfThePassesMatchesTheCpuTwinPatchForPatch) {

@@ -105,7 +105,8 @@ TEST(MakeSimulatorTest, GpuSimulatorRunsInTheContextItIsGiven) {
   const Volume volume = smallSphere();
   BakeResult given, own;
   {
-    auto context = std::make_unique<gl::GlContext>(gl::ContextOptions{.backend = gl::GlBackend::OSMesa});
+    auto context = std::make_unique<gl::GlContext>(
+        gl::ContextOptions{.backend = gl::glBackendFromEnvironment(gl::GlBackend::OSMesa)});
     const gl::GlContext* raw = context.get();
     test_scenes::glContext();
     GpuSimulator gpu(volume, GpuSimulatorOptions{}, std::move(context));
@@ -117,7 +118,7 @@ TEST(MakeSimulatorTest, GpuSimulatorRunsInTheContextItIsGiven) {
   EXPECT_EQ(gl::GlContext::current(), nullptr);  // it went with the simulator
   {
     GpuSimulatorOptions options;
-    options.backend = gl::GlBackend::OSMesa;
+    options.backend = gl::glBackendFromEnvironment(gl::GlBackend::OSMesa);
     GpuSimulator gpu(volume, options);  // none current: one of its own
     own = gpu.run(obliqueLight(), test_scenes::gpuTestOptions());
   }

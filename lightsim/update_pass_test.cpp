@@ -37,6 +37,7 @@ void expectOneUpdateMatchesTheCpuTwin(Integrator integrator) {
   const std::vector<PatchTexels> got = passes.b.download(count);
 
   double worstX = 0.0, worstW = 0.0, worstFlux = 0.0;
+  const double slack = test_scenes::gpuArithmeticSlack();
   for (std::size_t k = 0; k < count; ++k) {
     const Patch g = unpackPatch(got[k]);
     const Patch& c = want[k];
@@ -46,19 +47,20 @@ void expectOneUpdateMatchesTheCpuTwin(Integrator integrator) {
     }
     worstFlux = std::max(worstFlux, glm::length(g.flux - c.flux) / glm::length(c.flux));
     ASSERT_EQ(g.depth, c.depth) << k;
-    EXPECT_NEAR(g.n_in, c.n_in, 1e-4) << k;
-    EXPECT_NEAR(g.cos_in, c.cos_in, 1e-4) << k;
-    EXPECT_NEAR(g.t_fresnel, c.t_fresnel, 1e-4) << k;
-    EXPECT_NEAR(g.area0, c.area0, 1e-5 * c.area0 + 1e-12) << k;
+    EXPECT_NEAR(g.n_in, c.n_in, 1e-4 * slack) << k;
+    EXPECT_NEAR(g.cos_in, c.cos_in, 1e-4 * slack) << k;  // NVIDIA: 3.6e-4 at a grazing cos 0.016
+    EXPECT_NEAR(g.t_fresnel, c.t_fresnel, 1e-4 * slack) << k;
+    EXPECT_NEAR(g.area0, c.area0, (1e-5 * c.area0 + 1e-12) * slack) << k;
   }
   std::printf(
       "%zu patches, %d entered and %d left a boundary layer; worst |Δx| %.2e voxel, |Δw| %.2e, flux "
       "%.2e relative\n",
       count, entered, left, worstX, worstW, worstFlux);
   EXPECT_GT(entered + left, 0);
-  EXPECT_LT(worstX, 1e-4);
-  EXPECT_LT(worstW, 1e-4);
-  EXPECT_LT(worstFlux, 1e-4);
+  // llvmpipe's bounds; NVIDIA: |Δx| 3.5e-4 voxel, |Δw| 9.3e-4, flux 7.4e-5 (gpuArithmeticSlack).
+  EXPECT_LT(worstX, 1e-4 * slack);
+  EXPECT_LT(worstW, 1e-4 * slack);
+  EXPECT_LT(worstFlux, 1e-4 * slack);
 }
 
 TEST(UpdatePassTest, EulerStepMatchesTheCpuTwinPatchForPatch) { expectOneUpdateMatchesTheCpuTwin(Integrator::Euler); }

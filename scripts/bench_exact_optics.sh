@@ -217,7 +217,7 @@ cpu=$(awk -F': ' '/model name/ { print $2; exit }' /proc/cpuinfo)
   bake_renderer=$(/usr/bin/env python3 -c "import json, sys; print(json.load(open(sys.argv[1]))['renderer'])" \
     "$out/sphere${resolutions##* }_sharp.bake_stats.json" 2>/dev/null || echo "?")
   echo "Machine: $(uname -m), $(nproc) cores, ${cpu:-unknown CPU}; bake: $bake_renderer;" \
-    "viewer: ${EIKONAL_GL:-auto} OpenGL (llvmpipe unless a GPU's EGL is picked); POV-Ray +WT2."
+    "viewer: ${EIKONAL_GL:-auto} OpenGL (llvmpipe unless a GPU's EGL is picked)$([ "$pov" = 1 ] && echo "; POV-Ray +WT2")."
   echo "Camera (viewer and POV-Ray): eye ($eye), target ($target), fov_y $fov_y°, ${width}x$height, 1 ray/pixel."
   echo "Exact row: E in W/m², Φ in W. Other rows: ratio to exact per ring, deviation of Φ, shadow radius."
   echo "Times: median of $repeats runs of each command (wall seconds)."
