@@ -2,9 +2,10 @@
 // ALGORITHM.md step 4 with the track-length kernel ("Track deposits"; lightsim/track_deposit_pass.h):
 // one GL_POINTS vertex per (patch, z-slice), patch = uFirstPatch + gl_VertexID / uSpan, slice = the
 // (gl_VertexID mod uSpan)-th of the patch's box. The point covers, in that slice's atlas tile, the
-// x/y extent of the voxels whose trilinear hats the swept patch can touch: centres within one voxel
-// of the bounding box of its 8 corners (before and after the step), which holds every sub-path
-// (each is a segment between bilinear points of the two corner quads). track_deposit.frag computes
+// x/y extent of the voxels whose trilinear hats the swept patch can touch in that slice: centres
+// within one voxel of the hull of its 8 corners (before and after the step, which holds every
+// sub-path: each is a segment between bilinear points of the two corner quads) cut by the slab of z
+// that reaches the slice. track_deposit.frag computes
 // each voxel's deposit; fragments outside the box (a square point may spill past it, even into the
 // next tile) are discarded there.
 #include "lightsim/patch.glsl"
@@ -79,6 +80,42 @@ void main() {
   vmax = min(min(vmax, uDims - 1), vmin + uSpan - 1);  // an underestimated bound loses the far end
   int k = vmin.z + slot;
   if (any(greaterThan(vmin, vmax)) || k > vmax.z) return;
+
+  // This slice's own x/y box: only points with z in (k − ½, k + 1½) reach voxel k's hats, so the
+  // x/y extent that matters is that of the swept hull cut by that slab. The hull of the 8 corners
+  // cut by a slab is a convex polytope whose vertices are corners inside the slab or crossings of
+  // the slab's planes by hull edges; every edge is one of the 28 corner pairs, and a pair that is no
+  // edge crosses inside the hull, so the box of those points is the box of the cut, exactly. A slanted
+  // flight covers a few voxels of its whole box in each slice: the fragments (the pass' cost) shrink.
+  vec3 c[8] = vec3[8]((a0 - uBoundsMin) / voxelSize, (a1 - uBoundsMin) / voxelSize, (a2 - uBoundsMin) / voxelSize,
+                      (a3 - uBoundsMin) / voxelSize, (b0 - uBoundsMin) / voxelSize, (b1 - uBoundsMin) / voxelSize,
+                      (b2 - uBoundsMin) / voxelSize, (b3 - uBoundsMin) / voxelSize);
+  // 1e-3 voxel of allowance: float crossings must not shave a voxel whose hat the CPU reaches.
+  float zLow = float(k) - 0.5 - 1e-3, zHigh = float(k) + 1.5 + 1e-3;
+  vec2 cutLo = vec2(1e30), cutHi = vec2(-1e30);
+  for (int i = 0; i < 8; ++i) {
+    if (c[i].z >= zLow && c[i].z <= zHigh) {
+      cutLo = min(cutLo, c[i].xy);
+      cutHi = max(cutHi, c[i].xy);
+    }
+    for (int j = i + 1; j < 8; ++j) {
+      float dz = c[j].z - c[i].z;
+      for (int side = 0; side < 2; ++side) {
+        float plane = side == 0 ? zLow : zHigh;
+        if ((c[i].z - plane) * (c[j].z - plane) < 0.0) {
+          vec2 q = mix(c[i].xy, c[j].xy, (plane - c[i].z) / dz);
+          cutLo = min(cutLo, q);
+          cutHi = max(cutHi, q);
+        }
+      }
+    }
+  }
+  if (!(cutLo.x <= cutHi.x && cutLo.y <= cutHi.y)) return;  // the hull misses this slice's hats
+  cutLo = clamp(cutLo - 1e-3, vec2(-4.0), top.xy);
+  cutHi = clamp(cutHi + 1e-3, vec2(-4.0), top.xy);
+  vmin.xy = max(vmin.xy, ivec2(floor(cutLo - 1.5)) + 1);
+  vmax.xy = min(vmax.xy, ivec2(ceil(cutHi + 0.5)) - 1);
+  if (any(greaterThan(vmin.xy, vmax.xy))) return;
 
   // The lattice (cpu_simulator.cpp subPathLattice): the longer of the two u edges (x₀x₁, x₃x₂) and
   // v edges (x₁x₂, x₀x₃), before or after the step, in units of h.
