@@ -255,17 +255,33 @@ void FootprintSums::deposit(const std::array<glm::dvec2, 4>& footprint, const gl
                    flux_[static_cast<std::size_t>(k)], band * rows, (band + 1) * rows);
 }
 
-std::vector<glm::dvec3> FootprintSums::resolve() const {
+void FootprintSums::addCoarseLevels(std::vector<glm::dvec3>& out) const {
+  // Each texel adds the levels in the order k = 1, 2, ...: the same sums whatever the thread count.
+  parallelFor(
+      0, map_.texels.y,
+      [&](std::int64_t j64) {
+        const int j = static_cast<int>(j64);
+        glm::dvec3* row = out.data() + static_cast<std::size_t>(j) * static_cast<std::size_t>(map_.texels.x);
+        for (int k = 1; k <= kFootprintLevels; ++k) {
+          const ReceiverMap& level = coarse_[static_cast<std::size_t>(k - 1)];
+          const glm::dvec3* sums = flux_[static_cast<std::size_t>(k)].data() +
+                                   static_cast<std::size_t>(j >> k) * static_cast<std::size_t>(level.texels.x);
+          const double share = 1.0 / static_cast<double>(1 << (2 * k));
+          for (int i = 0; i < map_.texels.x; ++i) row[i] += sums[i >> k] * share;
+        }
+      },
+      16);
+}
+
+std::vector<glm::dvec3> FootprintSums::resolve() const& {
   std::vector<glm::dvec3> out = flux_[0];
-  for (int k = 1; k <= kFootprintLevels; ++k) {
-    const ReceiverMap& level = coarse_[static_cast<std::size_t>(k - 1)];
-    const std::vector<glm::dvec3>& sums = flux_[static_cast<std::size_t>(k)];
-    const double share = 1.0 / static_cast<double>(1 << (2 * k));
-    for (int j = 0; j < map_.texels.y; ++j)
-      for (int i = 0; i < map_.texels.x; ++i)
-        out[static_cast<std::size_t>(j) * static_cast<std::size_t>(map_.texels.x) + static_cast<std::size_t>(i)] +=
-            sums[static_cast<std::size_t>(j >> k) * static_cast<std::size_t>(level.texels.x) + static_cast<std::size_t>(i >> k)] * share;
-  }
+  addCoarseLevels(out);
+  return out;
+}
+
+std::vector<glm::dvec3> FootprintSums::resolve() && {
+  std::vector<glm::dvec3> out = std::move(flux_[0]);
+  addCoarseLevels(out);
   return out;
 }
 
