@@ -9,8 +9,11 @@
 //   draw     fragment-parallel scatter: one GL_POINTS vertex per (patch, z-slice), count·S vertices
 //            with S = maxExtentVoxels + 2. The vertex shader finds the voxel box of the hats the
 //            swept patch touches (centres within one voxel of the corners' bounding box, clamped to
-//            the grid), culls the slices outside it and covers the box's x/y extent in that slice's
-//            atlas tile with one square point (gl_PointSize). Each fragment is one voxel v: it sums,
+//            the grid), culls the slices outside it and covers, in that slice's atlas tile, the x/y
+//            extent of the swept hull cut by the slab of z that reaches the slice's hats (the 28
+//            corner pairs' crossings with its planes) with one square point (gl_PointSize): a
+//            slanted flight covers a few voxels of its box in each slice (BENCHMARKS.md "On a real
+//            GPU": the pass 1.7× faster on an H200). Each fragment is one voxel v: it sums,
 //            over the patch's n_u × n_v sub-paths, ∫ K_v ds exactly (the path cut at the hat's kinks,
 //            each piece by 2-point Gauss–Legendre, exact for the cubic), and additive blending sums
 //            the patches.
