@@ -47,9 +47,7 @@ int trackLattice(float edgeVoxels, float spacing) {
 float quadArea(vec3 x0, vec3 x1, vec3 x2, vec3 x3) { return 0.5 * length(cross(x2 - x0, x3 - x1)); }
 
 // A corner for track_deposit.frag: (voxel coordinates, height above the receiver plane).
-vec4 voxelCorner(vec3 x, vec3 voxelSize) {
-  return vec4((x - uBoundsMin) / voxelSize, dot(x - uReceiverPoint, uReceiverNormal));
-}
+vec4 voxelCorner(vec3 x, vec3 voxel) { return vec4(voxel, dot(x - uReceiverPoint, uReceiverNormal)); }
 
 void main() {
   int patchIndex = uFirstPatch + gl_VertexID / uSpan;
@@ -66,11 +64,15 @@ void main() {
   // The voxel box of the support: voxel n (centre n + ½ in continuous voxel coordinates) has a
   // non-zero hat somewhere on [lo, hi] iff lo − 1 < n + ½ < hi + 1, i.e. the integers strictly
   // inside (lo − 1.5, hi + 0.5); at most ⌈hi − lo⌉ + 2 ≤ S of them when hi − lo ≤ maxExtentVoxels.
+  // The 8 corners in continuous voxel coordinates, a0..a3 then b0..b3.
   vec3 voxelSize = (uBoundsMax - uBoundsMin) / vec3(uDims);
-  vec3 lo = min(min(min(a0, a1), min(a2, a3)), min(min(b0, b1), min(b2, b3)));
-  vec3 hi = max(max(max(a0, a1), max(a2, a3)), max(max(b0, b1), max(b2, b3)));
-  lo = (lo - uBoundsMin) / voxelSize;
-  hi = (hi - uBoundsMin) / voxelSize;
+  vec3 c[8] = vec3[8](a0, a1, a2, a3, b0, b1, b2, b3);
+  vec3 lo = vec3(1e30), hi = vec3(-1e30);
+  for (int i = 0; i < 8; ++i) {
+    c[i] = (c[i] - uBoundsMin) / voxelSize;
+    lo = min(lo, c[i]);
+    hi = max(hi, c[i]);
+  }
   if (any(isnan(lo)) || any(isnan(hi))) return;
   // Clamped first so that far-away corners convert to int safely (the box is clamped to the grid).
   vec3 top = vec3(uDims) + 2.0;
@@ -87,9 +89,6 @@ void main() {
   // the slab's planes by hull edges; every edge is one of the 28 corner pairs, and a pair that is no
   // edge crosses inside the hull, so the box of those points is the box of the cut, exactly. A slanted
   // flight covers a few voxels of its whole box in each slice: the fragments (the pass' cost) shrink.
-  vec3 c[8] = vec3[8]((a0 - uBoundsMin) / voxelSize, (a1 - uBoundsMin) / voxelSize, (a2 - uBoundsMin) / voxelSize,
-                      (a3 - uBoundsMin) / voxelSize, (b0 - uBoundsMin) / voxelSize, (b1 - uBoundsMin) / voxelSize,
-                      (b2 - uBoundsMin) / voxelSize, (b3 - uBoundsMin) / voxelSize);
   // 1e-3 voxel of allowance: float crossings must not shave a voxel whose hat the CPU reaches.
   float zLow = float(k) - 0.5 - 1e-3, zHigh = float(k) + 1.5 + 1e-3;
   vec2 cutLo = vec2(1e30), cutHi = vec2(-1e30);
@@ -127,10 +126,10 @@ void main() {
   float spacing = uDimIrradiance > 0.0 && max(info.r, max(info.g, info.b)) < uDimIrradiance * area ? 1.0 : 0.5;
   int nu = trackLattice(eu / uVoxelEdge, spacing), nv = trackLattice(ev / uVoxelEdge, spacing);
 
-  vBefore[0] = voxelCorner(a0, voxelSize); vBefore[1] = voxelCorner(a1, voxelSize);
-  vBefore[2] = voxelCorner(a2, voxelSize); vBefore[3] = voxelCorner(a3, voxelSize);
-  vAfter[0] = voxelCorner(b0, voxelSize); vAfter[1] = voxelCorner(b1, voxelSize);
-  vAfter[2] = voxelCorner(b2, voxelSize); vAfter[3] = voxelCorner(b3, voxelSize);
+  vBefore[0] = voxelCorner(a0, c[0]); vBefore[1] = voxelCorner(a1, c[1]);
+  vBefore[2] = voxelCorner(a2, c[2]); vBefore[3] = voxelCorner(a3, c[3]);
+  vAfter[0] = voxelCorner(b0, c[4]); vAfter[1] = voxelCorner(b1, c[5]);
+  vAfter[2] = voxelCorner(b2, c[6]); vAfter[3] = voxelCorner(b3, c[7]);
   vFlux = vec4(info.rgb / float(nu * nv), info.a >= 1.0 && uClipEnabled ? 1.0 : 0.0);
   vBox = ivec4(vmin.xy, vmax.xy);
   ivec2 origin = ivec2((k % ATLAS_TILES_X) * ATLAS_DIMS.x, (k / ATLAS_TILES_X) * ATLAS_DIMS.y);
