@@ -8,12 +8,15 @@ namespace eik {
 
 nlohmann::json InterfaceTable::toJson() const {
   nlohmann::json slots_json = nlohmann::json::array();
-  for (const InterfaceSlot& s : slots)
-    slots_json.push_back({{"name", s.name},
-                          {"ior", s.ior},
-                          {"dispersion_b", s.dispersion_b},
-                          {"graded", s.graded},
-                          {"opaque", s.opaque}});
+  for (const InterfaceSlot& s : slots) {
+    nlohmann::json slot = {{"name", s.name},
+                           {"ior", s.ior},
+                           {"dispersion_b", s.dispersion_b},
+                           {"graded", s.graded},
+                           {"opaque", s.opaque}};
+    if (s.sigma_a) slot["sigma_a"] = {s.sigma_a->x, s.sigma_a->y, s.sigma_a->z};
+    slots_json.push_back(slot);
+  }
   return {{"band", band}, {"slots", slots_json}};
 }
 
@@ -76,8 +79,17 @@ InterfaceTable interfaceTable(const Volume& volume, const std::string& source) {
         slot.graded = boolean(*it, source, field);
       } else if (k == "opaque") {
         slot.opaque = boolean(*it, source, field);
+      } else if (k == "sigma_a") {
+        if (!it->is_array() || it->size() != 3) throw InputError(source, field, "expected an array of 3 numbers");
+        glm::dvec3 sigma;
+        for (int c = 0; c < 3; ++c) {
+          sigma[c] = finiteNumber((*it)[static_cast<std::size_t>(c)], source, field);
+          if (!(sigma[c] >= 0.0)) throw InputError(source, field, "must not be negative");
+        }
+        slot.sigma_a = sigma;
       } else {
-        throw InputError(source, field, "unknown key (expected one of: dispersion_b, graded, ior, name, opaque)");
+        throw InputError(source, field,
+                         "unknown key (expected one of: dispersion_b, graded, ior, name, opaque, sigma_a)");
       }
     }
     table.slots.push_back(slot);

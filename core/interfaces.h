@@ -8,7 +8,8 @@
 // object is a slot of its own). The manifest lists the slots, innermost first:
 //
 //   "interfaces": {"band": 0.05, "slots": [
-//       {"name": "wine", "ior": 1.34, "dispersion_b": 0, "graded": false, "opaque": false}, ...]}
+//       {"name": "wine", "ior": 1.34, "dispersion_b": 0, "graded": false, "opaque": false,
+//        "sigma_a": [0.5, 8, 6]}, ...]}
 //
 // The material at a point x is the first slot k whose trilinearly interpolated distance d_k(x) is
 // negative (innermost wins, as in compositing), and air (n = 1) where none is. Inside a
@@ -20,6 +21,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +43,9 @@ struct InterfaceSlot {
   double dispersion_b = 0.0;  // Cauchy B, µm²
   bool graded = false;        // n varies inside: taken from the ior / ior_grad fields
   bool opaque = false;        // stops light; shaded with the `opaque` field
+  // σa of every object in the slot (per world unit, RGB) when they share one; absent when they
+  // differ or the volume predates it (then the `sigma_a` field alone describes absorption).
+  std::optional<glm::dvec3> sigma_a;
 };
 
 struct InterfaceTable {

@@ -165,6 +165,7 @@ struct SharpUpdate {
   int transmitted_mask = 0;
   int met_mask = 0;        // corners that met an interface (refracted, reflected or were stopped)
   int reflections = 0;     // total internal reflections, all corners
+  glm::dvec3 optical_depth{0.0};  // ¼ Σ_c ∫σa ds (σa per material; else 0)
 };
 SharpUpdate updateCornersSharp(Patch& patch, PatchSamples& samples, const StepContext& ctx, double dt) {
   SharpUpdate u;
@@ -178,16 +179,18 @@ SharpUpdate updateCornersSharp(Patch& patch, PatchSamples& samples, const StepCo
     u.blocked += cc.blocked ? 1 : 0;
     if (cc.transmitted > 0) u.transmitted_mask |= 1 << c;
     u.transmittance *= std::pow(cc.transmittance, 0.25);
+    u.optical_depth += 0.25 * cc.optical_depth;
   }
   return u;
 }
 
 // The time of a sharp volume's ordinary step for this patch: a straight step (ctx.step_dt) where
-// they apply and, with absorption, nothing absorbs within its reach of the corners (then step 2's
-// σa at the midpoint is 0 along the whole step, as it is); else Δt.
+// they apply and, with absorption, either σa is per material (each corner's path is absorbed piece
+// by piece, exactly) or nothing absorbs within its reach of the corners (then step 2's σa at the
+// midpoint is 0 along the whole step, as it is); else Δt.
 double sharpStepTime(const Patch& patch, const StepContext& ctx) {
   if (!(ctx.step_dt > ctx.dt)) return ctx.dt;
-  if (!ctx.sampler->hasAbsorption()) return ctx.step_dt;
+  if (!ctx.sampler->hasAbsorption() || ctx.sampler->absorptionPerMaterial()) return ctx.step_dt;
   if (!ctx.absorbers) return ctx.dt;
   glm::dvec3 lo = patch.x[0], hi = patch.x[0];
   for (int c = 1; c < 4; ++c) lo = glm::min(lo, patch.x[c]), hi = glm::max(hi, patch.x[c]);
@@ -353,10 +356,17 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
       advanceCorner(patch.x[c], patch.w[c], samples.corner[c], ctx.dt, options.integrator, sampler);
   }
 
-  // 2. Absorption at the old midpoint: Φ ← Φ·exp(−σa(m)·Δs_m) (Beer–Lambert).
+  // 2. Absorption at the old midpoint: Φ ← Φ·exp(−σa(m)·Δs_m) (Beer–Lambert); with σa per
+  //    material, Φ ← Φ·exp(−¼ Σ_c ∫σa ds) along the corners' paths, each piece in its material.
   if (sampler.hasAbsorption()) {
-    const glm::dvec3 sigma = sampler.sigmaA(m_old);
-    const glm::dvec3 transmitted = glm::exp(-sigma * ds);
+    glm::dvec3 optical_depth = crossing.optical_depth;
+    if (!(sharp && sampler.absorptionPerMaterial())) {
+      optical_depth = sampler.sigmaA(m_old) * ds;
+    } else if (flight > 0.0) {
+      for (int c = 0; c < 4; ++c)
+        optical_depth += 0.25 * sampler.materialSigmaA(patch.medium[c]) * (flight / samples.corner[c].x);
+    }
+    const glm::dvec3 transmitted = glm::exp(-optical_depth);
     result.absorbed = patch.flux * (1.0 - transmitted);
     patch.flux *= transmitted;
   }
@@ -661,7 +671,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
     ctx.quiet = &quiet_;
     ctx.flight_cap = glm::length(ctx.box_hi - ctx.box_lo);
   }
-  if (ctx.step_dt > ctx.dt && sampler_.hasAbsorption()) {
+  if (ctx.step_dt > ctx.dt && sampler_.hasAbsorption() && !sampler_.absorptionPerMaterial()) {
     if (absorbers_.empty()) absorbers_ = sampler_.absorberMap();
     ctx.absorbers = &absorbers_;
   }

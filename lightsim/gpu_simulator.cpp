@@ -96,9 +96,14 @@ struct GpuSimulator::Impl {
         sharp(sampler.sharp()),
         volume(uploadVolume(v, o)),
         volumeDefines(volume.layout().glslDefines() + (o.exact_sampling ? "#define EXACT_TRILINEAR 1\n" : "") +
-                      (sharp ? "#define SHARP_INTERFACES 1\n" : "")),
+                      (sharp ? "#define SHARP_INTERFACES 1\n" : "") +
+                      (sampler.absorptionPerMaterial() ? "#define MATERIAL_ABSORPTION 1\n" : "")),
         origin(0.5 * (grid.bounds_min + grid.bounds_max)),
-        gridUniforms(gpu::GridUniforms::from(localGrid(grid, origin), interfaceTable(v, o.source))) {}
+        gridUniforms(gpu::GridUniforms::from(localGrid(grid, origin), interfaceTable(v, o.source))) {
+    if (sampler.absorptionPerMaterial())
+      for (int k = 0; k < gridUniforms.slotCount; ++k)
+        gridUniforms.slotSigmaA[static_cast<std::size_t>(k)] = glm::vec3(sampler.materialSigmaA(k));
+  }
 
   static GridSpec localGrid(GridSpec g, const glm::dvec3& origin) {
     g.bounds_min -= origin;
@@ -155,14 +160,15 @@ struct GpuSimulator::Impl {
   }
   // The maps a run of `options` reads: free flight with track deposits (with volume deposits only
   // as far as the track deposit pass reaches, StepUniforms::flightExtentVoxels), straight steps
-  // where straightSteps allows them (an absorbing volume's only where its absorber map finds σa = 0).
+  // where straightSteps allows them (an absorbing volume's, unless σa is per material, only where its
+  // absorber map finds σa = 0).
   gpu::UpdateMaps updateMaps(const SimulationOptions& options, bool track) {
     gpu::UpdateMaps maps;
     if (options.free_flight && track) {
       if (!quietTable) quietTable = gpu::QuietTexture(sampler.quietMap());
       if (quietTable) maps.quiet = &quietTable;
     }
-    if (straightSteps(sampler, options) && sampler.hasAbsorption()) {
+    if (straightSteps(sampler, options) && sampler.hasAbsorption() && !sampler.absorptionPerMaterial()) {
       if (!absorberTable) absorberTable = gpu::QuietTexture(sampler.absorberMap());
       if (absorberTable) maps.absorbers = &absorberTable;
     }

@@ -36,6 +36,7 @@ void GridUniforms::set(const gl::Program& program) const {
     program.set("uSlotIor", std::span<const float>(slotIor));
     program.set("uSlotGraded", slotGraded);
     program.set("uSlotOpaque", slotOpaque);
+    program.set("uSlotSigmaA", std::span<const glm::vec3>(slotSigmaA));
   }
 }
 

@@ -4,7 +4,8 @@
 // from the grid in grid-local coordinates (x − the grid's centre), so that float positions keep their
 // precision however far the volume sits from the world origin.
 // With sharp interfaces (core/interfaces.h) they also carry the slot table of shaders/lightsim/
-// sharp.glsl: uSlotCount, uSlotIor[4], uSlotGraded and uSlotOpaque (bit k: slot k).
+// sharp.glsl: uSlotCount, uSlotIor[4], uSlotGraded and uSlotOpaque (bit k: slot k), and uSlotSigmaA[4]
+// (σa per material, VolumeSampler::absorptionPerMaterial; MATERIAL_ABSORPTION in the shaders).
 #pragma once
 
 #include <array>
@@ -27,6 +28,7 @@ struct GridUniforms {
   int slotCount = 0;          // sharp interfaces: the slot table
   std::array<float, 4> slotIor{1.0f, 1.0f, 1.0f, 1.0f};
   int slotGraded = 0, slotOpaque = 0;
+  std::array<glm::vec3, 4> slotSigmaA{};
   static GridUniforms from(const GridSpec& grid, const InterfaceTable& interfaces = {});
   void set(const gl::Program& program) const;
 };

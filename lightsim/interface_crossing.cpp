@@ -128,12 +128,18 @@ Refraction refract(const glm::dvec3& d, const glm::dvec3& normal, double n1, dou
 CornerCrossings advanceCornerSharp(glm::dvec3& x, glm::dvec3& w, int& medium, glm::dvec4& sample, double dt,
                                    Integrator integrator, const VolumeSampler& sampler) {
   CornerCrossings result;
+  const bool absorbing = sampler.absorptionPerMaterial();
+  // Beer–Lambert along one straight piece in `medium`.
+  auto absorb = [&](const glm::dvec3& from, const glm::dvec3& to) {
+    if (absorbing) result.optical_depth += sampler.materialSigmaA(medium) * glm::length(to - from);
+  };
   double remaining = dt;
   for (int crossing = 0; crossing <= kMaxCrossingsPerStep && remaining > 0.0; ++crossing) {
     glm::dvec3 x1 = x, w1 = w;
     rayStep(x1, w1, sample, remaining, integrator, medium, sampler);
     InterfaceHit hit;
     if (crossing == kMaxCrossingsPerStep || !findInterface(sampler, x, x1, medium, hit) || hit.entered == medium) {
+      absorb(x, x1);
       x = x1;
       sample = sampler.materialOptics(medium, x);
       w = renormalised(w1, sample.x);  // |w| = n (ALGORITHM.md step 1)
@@ -142,6 +148,7 @@ CornerCrossings advanceCornerSharp(glm::dvec3& x, glm::dvec3& w, int& medium, gl
     // Up to the interface (time ∝ distance on the chord in a homogeneous material).
     const glm::dvec3 p = x + hit.fraction * (x1 - x);
     remaining *= 1.0 - hit.fraction;
+    absorb(x, p);
     x = p;
     const glm::dvec3 normal = sampler.interfaceNormal(hit.slot, p);
     result.last_slot = hit.slot;

@@ -27,6 +27,9 @@ struct CornerCrossings {
   bool blocked = false;         // stopped at an opaque surface
   double transmittance = 1.0;   // Π (1 − R) over its refractions
   int last_slot = -1;           // the slot whose surface it crossed last (−1: none)
+  // ∫σa ds along its path, each piece with its material's σa (VolumeSampler::
+  // absorptionPerMaterial(); 0 otherwise): the chord's length in each material it passed.
+  glm::dvec3 optical_depth{0.0};
 };
 
 // The crossing of one interface along the chord a → b (a in material `from`): the fraction f of

@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -109,6 +110,17 @@ class VolumeSampler {
   // material the point is in (materialOptics(materialAt(world), world)).
   glm::dvec4 iorAndGradient(const glm::dvec3& world) const;
   glm::dvec3 sigmaA(const glm::dvec3& world) const;
+  // σa per material (sharp interfaces with absorption; docs/physics.md "Absorption at sharp
+  // interfaces"): true when each transparent material has one σa — the slot table's `sigma_a`, or
+  // else the field's value at its voxels more than a voxel diagonal from every surface (the field's
+  // ramp across a surface is the voxelizer's coverage blend) — which agrees with the field at every
+  // such voxel, and σa = 0 at those in air. Then σa at a point is its material's, and a ray's
+  // absorbing length ends on the interface itself, not on the field's ramp (exact Beer–Lambert).
+  bool absorptionPerMaterial() const { return absorption_per_material_; }
+  // σa of material `slot` (−1: air, 0); meaningful when absorptionPerMaterial().
+  glm::dvec3 materialSigmaA(int slot) const {
+    return slot >= 0 ? slot_sigma_a_[static_cast<std::size_t>(slot)] : glm::dvec3(0.0);
+  }
 
   // Sharp interfaces (core/interfaces.h); an empty table and slot −1 everywhere without them.
   bool sharp() const { return !table_.empty(); }
@@ -139,6 +151,9 @@ class VolumeSampler {
   glm::dvec3 tap_scale_{1.0};  // dims/extent: world to voxel coordinates (taps3)
   std::vector<glm::vec4> ior_grad_;  // (n, ∇n) per voxel
   std::vector<glm::vec3> sigma_a_;   // empty: no absorption
+  bool absorption_per_material_ = false;
+  std::array<glm::dvec3, kMaxInterfaceSlots> slot_sigma_a_{};
+  void findMaterialAbsorption();
   InterfaceTable table_;
   std::vector<glm::vec4> distances_; // empty without sharp interfaces
   // The used slots' distances alone, slotCount() floats a voxel (a quarter of distances_ for one

@@ -54,11 +54,15 @@ SlotAssignment assignInterfaceSlots(const std::vector<Region>& regions, double b
       slot.dispersion_b = r.material.opaque ? 0.0 : static_cast<double>(r.material.dispersion_b);
       slot.graded = graded(r);
       slot.opaque = r.material.opaque;
+      if (!r.material.opaque) slot.sigma_a = glm::dvec3(r.material.sigma_a);
       found = slot_of_key.emplace(key, static_cast<int>(result.table.slots.size())).first;
       result.table.slots.push_back(slot);
       names.push_back(r.name);
     } else {
       names[static_cast<std::size_t>(found->second)] += ", " + r.name;
+      // Objects of one n but different σa: the slot has no σa of its own (the field has it).
+      InterfaceSlot& slot = result.table.slots[static_cast<std::size_t>(found->second)];
+      if (slot.sigma_a && *slot.sigma_a != glm::dvec3(r.material.sigma_a)) slot.sigma_a.reset();
     }
     result.slot_of_region[i] = found->second;
   }

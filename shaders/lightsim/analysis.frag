@@ -61,9 +61,12 @@ bool footprintExists(Patch p) {
 
 // Step 2's factor a as the update pass applied it, read from its result: Φ = Φ_old · a · T_fresnel
 // per channel. The step's time (Δt, a straight step's or a free flight's) is the update's alone.
-// Where σa(m_old) = 0, a = 1 exactly; 1 where no flux came in.
+// Where σa(m_old) = 0, a = 1 exactly (with σa per material the corners may absorb wherever the
+// midpoint is: always read); 1 where no flux came in.
 vec3 stepAbsorptionFactor(vec3 mOld, vec3 fluxOld, vec3 flux, float tFresnel) {
+#ifndef MATERIAL_ABSORPTION
   if (all(equal(sampleSigmaA(mOld), vec3(0.0)))) return vec3(1.0);
+#endif
   vec3 a = vec3(1.0);
   for (int c = 0; c < 3; ++c) {
     float before = fluxOld[c] * tFresnel;

@@ -140,7 +140,8 @@ float freeFlightTime(Patch p) {
 #endif
 
 // sharpStepTime (cpu_simulator.cpp): a straight step where nothing absorbs within its reach of
-// the corners (with absorption), else Δt. uStepDt is Δt when straight steps are off.
+// the corners (with absorption; with σa per material anywhere: no absorber map then), else Δt.
+// uStepDt is Δt when straight steps are off.
 float sharpStepTime(Patch p) {
   if (!(uStepDt > uDt)) return uDt;
 #ifdef ABSORBER_MAP

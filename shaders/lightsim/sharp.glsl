@@ -12,6 +12,10 @@ uniform int uSlotCount;
 uniform float uSlotIor[4];
 uniform int uSlotGraded;  // bit k: slot k takes n and ∇n from the ior / ior_grad fields
 uniform int uSlotOpaque;  // bit k: slot k stops light
+#ifdef MATERIAL_ABSORPTION
+uniform vec3 uSlotSigmaA[4];  // σa per material (VolumeSampler::absorptionPerMaterial)
+vec3 materialSigmaA(int slot) { return slot >= 0 ? uSlotSigmaA[slot] : vec3(0.0); }
+#endif
 
 // The slot distances d_k at x (trilinear, clamp to edge; unused slots read +band).
 vec4 sampleDistances(vec3 x) {
@@ -170,13 +174,14 @@ struct CornerCrossings {
   int reflected;        // total internal reflections
   bool blocked;         // stopped at an opaque surface
   float transmittance;  // Π (1 − R) over its refractions
+  vec3 opticalDepth;    // ∫σa ds, each chord piece with its material's σa (MATERIAL_ABSORPTION)
 };
 
 // advanceCornerSharp: corner (x, w) in `medium` goes on for Δt = dt, stopping at each interface
 // its chord meets (at most kMaxCrossingsPerStep): opaque → stops; past the critical angle →
 // mirrored; else refracted by Snell's law, keeping 1 − R.
 CornerCrossings advanceCornerSharp(inout vec3 x, inout vec3 w, inout int medium, float dt) {
-  CornerCrossings result = CornerCrossings(0, 0, false, 1.0);
+  CornerCrossings result = CornerCrossings(0, 0, false, 1.0, vec3(0.0));
   float remaining = dt;
   for (int crossing = 0; crossing <= kMaxCrossingsPerStep; ++crossing) {
     if (!(remaining > 0.0)) break;
@@ -185,12 +190,18 @@ CornerCrossings advanceCornerSharp(inout vec3 x, inout vec3 w, inout int medium,
     float f;
     int slot, entered;
     if (crossing == kMaxCrossingsPerStep || !findInterface(x, x1, medium, f, slot, entered) || entered == medium) {
+#ifdef MATERIAL_ABSORPTION
+      result.opticalDepth += materialSigmaA(medium) * distance(x, x1);
+#endif
       x = x1;
       w = normalize(w1) * materialOptics(medium, x).x;  // |w| = n (ALGORITHM.md step 1)
       return result;
     }
     vec3 p = x + f * (x1 - x);
     remaining *= 1.0 - f;
+#ifdef MATERIAL_ABSORPTION
+    result.opticalDepth += materialSigmaA(medium) * distance(x, p);
+#endif
     x = p;
     vec3 normal = interfaceNormal(slot, p);
     if (slotOpaque(entered)) {

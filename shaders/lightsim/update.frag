@@ -125,6 +125,7 @@ void main() {
   // the swept box), or an ordinary step of Δt (a straight step where they apply) in which every
   // corner crosses the interfaces on its way.
   float transmittance = 1.0;
+  vec3 opticalDepth = vec3(0.0);  // ¼ Σ_c ∫σa ds (MATERIAL_ABSORPTION)
   int metMask = 0, transmittedMask = 0, blocked = 0, reflections = 0;
   float flight = 0.0;
 #ifdef FREE_FLIGHT
@@ -135,6 +136,9 @@ void main() {
     for (int c = 0; c < 4; ++c) {
       float n = materialOptics(p.medium[c], p.x[c]).x;
       p.x[c] += flight * p.w[c] / (n * n);  // Eq. 6.1, exact for a straight ray
+#ifdef MATERIAL_ABSORPTION
+      opticalDepth += 0.25 * materialSigmaA(p.medium[c]) * (flight / n);
+#endif
     }
   } else {
     stepTime = sharpStepTime(p);
@@ -145,6 +149,7 @@ void main() {
       blocked += cc.blocked ? 1 : 0;
       if (cc.transmitted > 0) transmittedMask |= 1 << c;
       transmittance *= pow(cc.transmittance, 0.25);
+      opticalDepth += 0.25 * cc.opticalDepth;
     }
   }
   p.reflections += reflections;
@@ -167,8 +172,13 @@ void main() {
     }
   }
 
-  // Step 2: absorption at the old midpoint over the step, n of its material there.
+  // Step 2: absorption at the old midpoint over the step, n of its material there; with σa per
+  // material, along the corners' paths piece by piece (Beer–Lambert).
+#ifdef MATERIAL_ABSORPTION
+  p.flux *= exp(-opticalDepth);
+#else
   p.flux *= sharpAbsorptionFactor(mOld, stepTime);
+#endif
 
   // Step 3: Fresnel at the interfaces the corners crossed; the reflected fraction is remembered
   // until every corner is through (the analysis may then follow the reflected wavefront).
