@@ -34,6 +34,23 @@ TEST(Interfaces, ReadsTheSlotsInnermostFirst) {
   EXPECT_EQ(interfaceTable(withTable(t.toJson())).slots[1].ior, 1.5);
 }
 
+TEST(Interfaces, ASlotsAbsorptionIsOptionalAndSurvivesARoundTrip) {
+  const InterfaceTable t = interfaceTable(withTable(
+      {{"band", 0.1},
+       {"slots", {{{"name", "wine"}, {"ior", 1.34}, {"sigma_a", {0.5, 8.0, 6.0}}}, {{"name", "glass"}, {"ior", 1.5}}}}}));
+  ASSERT_TRUE(t.slots[0].sigma_a.has_value());
+  EXPECT_EQ(*t.slots[0].sigma_a, glm::dvec3(0.5, 8.0, 6.0));
+  EXPECT_FALSE(t.slots[1].sigma_a.has_value());  // older volumes: the field alone
+  const InterfaceTable back = interfaceTable(withTable(t.toJson()));
+  EXPECT_EQ(back.slots[0].sigma_a, t.slots[0].sigma_a);
+  EXPECT_FALSE(back.slots[1].sigma_a.has_value());
+  for (const nlohmann::json& bad : {nlohmann::json{1.0, 2.0}, nlohmann::json{1.0, -2.0, 0.0}, nlohmann::json("red")})
+    EXPECT_CONTAINS(inputErrorOf([&] {
+                      interfaceTable(withTable({{"band", 0.1}, {"slots", {{{"ior", 1.5}, {"sigma_a", bad}}}}}));
+                    }),
+                    "interfaces.slots[0].sigma_a");
+}
+
 TEST(Interfaces, AVolumeWithoutThemHasAnEmptyTable) {
   Volume v;
   v.grid.dims = {2, 2, 2};

@@ -174,6 +174,56 @@ TEST(VolumeSampler, TheMaterialAtAPointIsThatOfItsInterpolatedDistances) {
   }
 }
 
+// σa per material (VolumeSampler::absorptionPerMaterial): each material's σa from the slot table or
+// its deep voxels, refused (the field then decides) wherever the σa field says otherwise.
+TEST(VolumeSampler, AbsorptionIsPerMaterialWhereTheFieldIsOneValueInsideEach) {
+  // Wine in a sphere, a glass plate too thin for any voxel to lie a voxel diagonal inside it.
+  const std::vector<std::string> specs = {"procedural:sphere,r=0.3,ior=1.33,sigma_a=1:2:3,name=wine",
+                                          "procedural:box,size=0.8:0.05:0.8,center=0:-0.4:0,ior=1.5,name=glass"};
+  const Volume v = test_scenes::sharpVolume(specs, 24, test_scenes::cube(0.5));
+  const VolumeSampler sampler(v);
+  ASSERT_TRUE(sampler.absorptionPerMaterial());
+  auto slotNamed = [](const VolumeSampler& s, const std::string& name) {
+    for (int k = 0; k < s.slotCount(); ++k)
+      if (s.interfaces().slots[static_cast<std::size_t>(k)].name == name) return k;
+    ADD_FAILURE() << "no slot " << name;
+    return -1;
+  };
+  const int wine = slotNamed(sampler, "wine"), glass = slotNamed(sampler, "glass");
+  EXPECT_EQ(sampler.materialSigmaA(wine), glm::dvec3(1.0, 2.0, 3.0));
+  EXPECT_EQ(sampler.materialSigmaA(glass), glm::dvec3(0.0));
+  EXPECT_EQ(sampler.materialSigmaA(-1), glm::dvec3(0.0));
+
+  auto withoutRecordedSigma = [](Volume volume) {
+    for (nlohmann::json& slot : volume.metadata["interfaces"]["slots"]) slot.erase("sigma_a");
+    return volume;
+  };
+  // An older volume (no σa in the table): the thin plate has no deep voxel to read σa from.
+  EXPECT_FALSE(VolumeSampler(withoutRecordedSigma(v)).absorptionPerMaterial());
+  // With a thick plate every material has deep voxels, and their σa is each material's.
+  const Volume thick = withoutRecordedSigma(test_scenes::sharpVolume(
+      {specs[0], "procedural:box,size=0.8:0.2:0.8,center=0:-0.4:0,ior=1.5,name=glass"}, 24, test_scenes::cube(0.5)));
+  const VolumeSampler inferred(thick);
+  ASSERT_TRUE(inferred.absorptionPerMaterial());
+  EXPECT_EQ(inferred.materialSigmaA(slotNamed(inferred, "wine")), glm::dvec3(1.0, 2.0, 3.0));
+  EXPECT_EQ(inferred.materialSigmaA(slotNamed(inferred, "glass")), glm::dvec3(0.0));
+
+  // The field disagrees: deep inside the wine, in the air, or with the table.
+  const std::size_t centre = v.grid.index(12, 12, 12), corner = v.grid.index(1, 22, 1);
+  ASSERT_EQ(sampler.materialAt(v.grid.center(12, 12, 12)), wine);
+  ASSERT_EQ(sampler.materialAt(v.grid.center(1, 22, 1)), -1);
+  for (const std::size_t voxel : {centre, corner}) {
+    Volume changed = v;
+    changed.fields.at("sigma_a").voxel(voxel)[1] = 2.5f;
+    EXPECT_FALSE(VolumeSampler(changed).absorptionPerMaterial()) << voxel;
+  }
+  Volume recorded_differently = v;
+  recorded_differently.metadata["interfaces"]["slots"][wine]["sigma_a"] = {1.0, 2.0, 3.5};
+  EXPECT_FALSE(VolumeSampler(recorded_differently).absorptionPerMaterial());
+  // Smooth interfaces: σa is the field's.
+  EXPECT_FALSE(VolumeSampler(test_scenes::proceduralVolume(specs[0], 24)).absorptionPerMaterial());
+}
+
 TEST(VolumeSampler, RequiresIorAndGradient) {
   Volume v;
   v.grid = smallGrid();

@@ -54,6 +54,37 @@ TEST(SharpInterfaces, SlotsAreMaterialsInnermostFirst) {
   EXPECT_EQ(slots.slot_of_region[5], -1);                        // the smoke
 }
 
+// Each slot records the σa its objects share (lightsim's σa per material), and none when they differ.
+TEST(SharpInterfaces, ASlotRecordsTheAbsorptionItsObjectsShare) {
+  const GridSpec g = cube(16, 0.6);
+  const auto shared = assignInterfaceSlots(
+      regionsOf({"procedural:sphere,r=0.2,center=-0.3:0:0,ior=1.33,sigma_a=1:2:3,name=a",
+                 "procedural:sphere,r=0.2,center=0.3:0:0,ior=1.33,sigma_a=1:2:3,name=b",
+                 "procedural:box,size=0.2,center=0:0.4:0,ior=1.5,name=glass",
+                 "procedural:sphere,r=0.05,center=0:-0.4:0,albedo=0.1:0.1:0.1,sigma_a=4,name=grain"},
+                g),
+      interfaceBand(g));
+  ASSERT_EQ(shared.table.slots.size(), 3u);
+  const auto slotOf = [&](double ior, bool opaque) {
+    for (const InterfaceSlot& s : shared.table.slots)
+      if (s.ior == ior && s.opaque == opaque) return s;
+    ADD_FAILURE() << "no slot of n = " << ior;
+    return InterfaceSlot{};
+  };
+  EXPECT_EQ(slotOf(1.5, false).sigma_a, glm::dvec3(0.0));
+  EXPECT_EQ(slotOf(1.0, true).sigma_a, std::nullopt);  // stops light: no σa
+  const InterfaceSlot liquid = slotOf(static_cast<double>(1.33f), false);
+  ASSERT_TRUE(liquid.sigma_a.has_value());
+  EXPECT_EQ(*liquid.sigma_a, glm::dvec3(1.0, 2.0, 3.0));
+  const auto differ = assignInterfaceSlots(
+      regionsOf({"procedural:sphere,r=0.2,center=-0.3:0:0,ior=1.33,sigma_a=1:2:3,name=a",
+                 "procedural:sphere,r=0.2,center=0.3:0:0,ior=1.33,sigma_a=1,name=b"},
+                g),
+      interfaceBand(g));
+  ASSERT_EQ(differ.table.slots.size(), 1u);
+  EXPECT_FALSE(differ.table.slots[0].sigma_a.has_value());
+}
+
 TEST(SharpInterfaces, MoreThanFourMaterialsIsAnErrorNamingThem) {
   const GridSpec g = cube(12, 1.0);
   std::vector<std::string> specs;
