@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/parallel.h"
 
 namespace eik {
 
@@ -35,6 +36,61 @@ bool boolean(const nlohmann::json& j, const std::string& source, const std::stri
 }
 
 }  // namespace
+
+MaterialValues deepMaterialValues(const Volume& volume, const InterfaceTable& table, const Field& field, double depth) {
+  const int slots = static_cast<int>(table.slots.size());
+  const std::size_t media = static_cast<std::size_t>(slots) + 1;
+  MaterialValues result;
+  result.seen.assign(media, false);
+  result.value.assign(media, glm::dvec3(0.0));
+  const Field* interfaces = volume.find("interfaces");
+  if (!interfaces || slots == 0) return result;
+  const int components = std::min(field.components, 3);
+  // In chunks of voxels in parallel, each with its own first values, merged in order.
+  constexpr std::size_t kChunk = 1 << 16;
+  const std::size_t count = volume.grid.count();
+  std::vector<MaterialValues> chunks((count + kChunk - 1) / kChunk, result);
+  auto differ = [](const glm::dvec3& a, const glm::dvec3& b) {
+    for (int c = 0; c < 3; ++c)
+      if (std::abs(a[c] - b[c]) > 1e-6 * (1.0 + std::abs(b[c]))) return true;
+    return false;
+  };
+  parallelFor(0, static_cast<std::int64_t>(chunks.size()), [&](std::int64_t chunk) {
+    MaterialValues& part = chunks[static_cast<std::size_t>(chunk)];
+    const std::size_t begin = static_cast<std::size_t>(chunk) * kChunk, end = std::min(count, begin + kChunk);
+    for (std::size_t v = begin; v < end && part.one_value; ++v) {
+      const float* d = interfaces->voxel(v);
+      glm::dvec4 distances(1e30);
+      bool deep = true;
+      for (int k = 0; k < slots; ++k) {
+        distances[k] = d[k];
+        deep = deep && std::abs(d[k]) >= depth;
+      }
+      if (!deep) continue;
+      const int slot = materialSlot(distances, slots);
+      if (slot >= 0 && table.slots[static_cast<std::size_t>(slot)].opaque) continue;
+      const std::size_t m = static_cast<std::size_t>(slot + 1);
+      glm::dvec3 x(0.0);
+      for (int c = 0; c < components; ++c) x[c] = field.voxel(v)[c];
+      if (!part.seen[m]) {
+        part.seen[m] = true;
+        part.value[m] = x;
+      } else if (differ(x, part.value[m])) {
+        part.one_value = false;
+      }
+    }
+  });
+  for (const MaterialValues& part : chunks) {
+    result.one_value = result.one_value && part.one_value;
+    for (std::size_t m = 0; m < media && result.one_value; ++m) {
+      if (!part.seen[m]) continue;
+      if (result.seen[m] && differ(part.value[m], result.value[m])) result.one_value = false;
+      result.seen[m] = true;
+      result.value[m] = part.value[m];
+    }
+  }
+  return result;
+}
 
 InterfaceTable interfaceTable(const Volume& volume, const std::string& source) {
   InterfaceTable table;

@@ -61,6 +61,23 @@ struct InterfaceTable {
 // count, or a field without a table (and the reverse).
 InterfaceTable interfaceTable(const Volume& volume, const std::string& source = "volume");
 
+// Each material's value of a per-voxel `field` (up to 3 components) where it is one constant
+// throughout the material, read from the voxels at least `depth` (world units) from every slot
+// surface, where the voxelizer blends nothing in (voxelize/composite.h mixes regions by coverage
+// only within a voxel of their surfaces). Index 0 is air, 1 + k slot k; opaque slots are not
+// looked at (no ray goes on in them). `one_value` is false when a material's deep voxels disagree
+// (beyond a relative 1e-6: two objects of one n and different σa share a slot; smoke in the air);
+// a material with no deep voxel (a wall thinner than two voxels) is not `seen`.
+struct MaterialValues {
+  bool one_value = true;
+  std::vector<bool> seen;          // [0] air, [1 + k] slot k
+  std::vector<glm::dvec3> value;   // where seen (unused components 0)
+};
+MaterialValues deepMaterialValues(const Volume& volume, const InterfaceTable& table, const Field& field, double depth);
+// The depth, in (smallest) voxel edges, beyond which a voxel is deep inside its material: a voxel
+// cube's corners lie √3/2 edges from its centre, so nothing of another object is blended in.
+constexpr double kDeepVoxels = 1.0;
+
 // Which material a point is in: the slot index, or −1 for air.
 inline int materialSlot(const glm::dvec4& distances, int slot_count) {
   for (int k = 0; k < slot_count; ++k)

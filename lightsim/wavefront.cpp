@@ -196,66 +196,27 @@ VolumeSampler::VolumeSampler(const Volume& volume)
       for (std::size_t i = 0; i < n; ++i) sigma_a_[i] = glm::vec3(sa->voxel(i)[0], sa->voxel(i)[1], sa->voxel(i)[2]);
     }
   }
-  findMaterialAbsorption();
+  findMaterialAbsorption(volume);
 }
 
-void VolumeSampler::findMaterialAbsorption() {
-  if (!sharp() || sigma_a_.empty()) return;
-  // A voxel whose centre lies more than a voxel diagonal from every surface is wholly inside one
-  // material, so the voxelizer's coverage blend gives it that material's σa unmixed.
-  const float far = static_cast<float>(glm::length(grid_.voxelSize()));
-  const int used = slotCount();
-  struct Seen {
-    std::array<glm::vec3, kMaxInterfaceSlots> value{};
-    std::array<bool, kMaxInterfaceSlots> found{};
-    bool consistent = true;
-  };
-  constexpr std::size_t kChunk = 1 << 16;
-  const std::size_t n = sigma_a_.size();
-  std::vector<Seen> chunks((n + kChunk - 1) / kChunk);
-  parallelFor(0, static_cast<std::int64_t>(chunks.size()), [&](std::int64_t c) {
-    Seen& seen = chunks[static_cast<std::size_t>(c)];
-    const std::size_t begin = static_cast<std::size_t>(c) * kChunk, end = std::min(n, begin + kChunk);
-    for (std::size_t i = begin; i < end && seen.consistent; ++i) {
-      const glm::vec4& d = distances_[i];
-      bool interior = true;
-      for (int k = 0; k < used; ++k) interior = interior && std::abs(d[k]) > far;
-      if (!interior) continue;
-      const int slot = materialSlot(glm::dvec4(d), used);
-      if (slot < 0) {
-        seen.consistent = sigma_a_[i] == glm::vec3(0.0f);
-      } else if (!seen.found[static_cast<std::size_t>(slot)]) {
-        seen.found[static_cast<std::size_t>(slot)] = true;
-        seen.value[static_cast<std::size_t>(slot)] = sigma_a_[i];
-      } else {
-        seen.consistent = sigma_a_[i] == seen.value[static_cast<std::size_t>(slot)];
-      }
-    }
-  });
-  Seen all;
-  for (const Seen& seen : chunks) {
-    if (!seen.consistent) return;
-    for (int k = 0; k < used; ++k) {
-      const std::size_t s = static_cast<std::size_t>(k);
-      if (!seen.found[s]) continue;
-      if (all.found[s] && all.value[s] != seen.value[s]) return;
-      all.found[s] = true;
-      all.value[s] = seen.value[s];
-    }
-  }
+void VolumeSampler::findMaterialAbsorption(const Volume& volume) {
+  const Field* sigma = volume.find("sigma_a");
+  if (!sharp() || sigma_a_.empty() || !sigma) return;
+  const MaterialValues deep = deepMaterialValues(volume, table_, *sigma, kDeepVoxels * h_);
+  if (!deep.one_value || (deep.seen[0] && deep.value[0] != glm::dvec3(0.0))) return;  // σa in the air
   // Each transparent material's σa: the one the voxelizer recorded in the slot table, which its deep
   // voxels must agree with; else that of its deep voxels. A material with neither (a wall thinner
-  // than two voxel diagonals in a volume from before the table held σa) leaves σa to the field.
-  for (int k = 0; k < used; ++k) {
-    const std::size_t s = static_cast<std::size_t>(k);
+  // than two voxels in a volume from before the table held σa) leaves σa to the field.
+  for (int k = 0; k < slotCount(); ++k) {
+    const std::size_t s = static_cast<std::size_t>(k), m = s + 1;
     const std::optional<glm::dvec3>& recorded = table_.slots[s].sigma_a;
     if (opaque(k)) {
       slot_sigma_a_[s] = glm::dvec3(0.0);
     } else if (recorded) {
-      if (all.found[s] && all.value[s] != glm::vec3(*recorded)) return;
+      if (deep.seen[m] && glm::vec3(deep.value[m]) != glm::vec3(*recorded)) return;
       slot_sigma_a_[s] = *recorded;
-    } else if (all.found[s]) {
-      slot_sigma_a_[s] = glm::dvec3(all.value[s]);
+    } else if (deep.seen[m]) {
+      slot_sigma_a_[s] = deep.value[m];
     } else {
       return;
     }

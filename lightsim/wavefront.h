@@ -112,9 +112,9 @@ class VolumeSampler {
   glm::dvec3 sigmaA(const glm::dvec3& world) const;
   // σa per material (sharp interfaces with absorption; docs/physics.md "Absorption at sharp
   // interfaces"): true when each transparent material has one σa — the slot table's `sigma_a`, or
-  // else the field's value at its voxels more than a voxel diagonal from every surface (the field's
-  // ramp across a surface is the voxelizer's coverage blend) — which agrees with the field at every
-  // such voxel, and σa = 0 at those in air. Then σa at a point is its material's, and a ray's
+  // else the field's at its deep voxels (core/interfaces.h deepMaterialValues; the field's ramp
+  // across a surface is the voxelizer's coverage blend) — which agrees with the field at every deep
+  // voxel, and σa = 0 at those in air. Then σa at a point is its material's, and a ray's
   // absorbing length ends on the interface itself, not on the field's ramp (exact Beer–Lambert).
   bool absorptionPerMaterial() const { return absorption_per_material_; }
   // σa of material `slot` (−1: air, 0); meaningful when absorptionPerMaterial().
@@ -153,7 +153,7 @@ class VolumeSampler {
   std::vector<glm::vec3> sigma_a_;   // empty: no absorption
   bool absorption_per_material_ = false;
   std::array<glm::dvec3, kMaxInterfaceSlots> slot_sigma_a_{};
-  void findMaterialAbsorption();
+  void findMaterialAbsorption(const Volume& volume);
   InterfaceTable table_;
   std::vector<glm::vec4> distances_; // empty without sharp interfaces
   // The used slots' distances alone, slotCount() floats a voxel (a quarter of distances_ for one

@@ -160,48 +160,30 @@ SlotMedia slotMedia(const Volume& volume, const InterfaceTable& table) {
   result.media.assign(static_cast<std::size_t>(slots) + 1, MaterialMedium{});
   const GridSpec& grid = volume.grid;
   const double depth = kMediumDepthVoxels * std::min({grid.voxelSize().x, grid.voxelSize().y, grid.voxelSize().z});
-  // For one field: each material's value where it is deep inside, and whether it is one value there.
-  auto constantIn = [&](const Field* field, int components, auto&& store) {
+  // For one field: each material's value where it is deep inside, and whether it is one value there;
+  // `recorded` (σa: the slot table's) stands in for a material with no deep voxel and must agree
+  // with its deep voxels where it has some.
+  auto constantIn = [&](const Field* field, auto&& recorded, auto&& store) {
     if (!field) return true;  // absent: 0 everywhere, as the media start
-    std::vector<bool> seen(result.media.size(), false);
-    std::vector<std::array<float, 3>> value(result.media.size());
-    for (std::size_t v = 0; v < grid.count(); ++v) {
-      const float* d = interfaces->voxel(v);
-      glm::dvec4 distances(1e30);
-      bool deep = true;
-      for (int k = 0; k < slots; ++k) {
-        distances[k] = d[k];
-        deep = deep && std::abs(d[k]) >= depth;
-      }
-      if (!deep) continue;
-      const int slot = materialSlot(distances, slots);
-      if (slot >= 0 && table.slots[static_cast<std::size_t>(slot)].opaque) continue;
-      const std::size_t m = static_cast<std::size_t>(slot + 1);
-      const float* x = field->voxel(v);
-      if (!seen[m]) {
-        seen[m] = true;
-        std::copy(x, x + components, value[m].begin());
-        continue;
-      }
-      for (int c = 0; c < components; ++c)
-        if (std::abs(x[c] - value[m][static_cast<std::size_t>(c)]) > 1e-6f * (1.0f + std::abs(value[m][static_cast<std::size_t>(c)])))
-          return false;
-    }
+    const MaterialValues deep = deepMaterialValues(volume, table, *field, depth);
+    if (!deep.one_value) return false;
     for (std::size_t m = 0; m < result.media.size(); ++m) {
       const bool opaque = m > 0 && table.slots[m - 1].opaque;
-      // A material never met deep inside: unknown, unless it is air (a material that fills the box
-      // leaves no air inside it) or opaque (no ray goes on in it).
-      if (!seen[m] && m > 0 && !opaque) return false;
-      if (seen[m]) store(result.media[m], value[m]);
+      const std::optional<glm::dvec3> known = m > 0 ? recorded(table.slots[m - 1]) : std::nullopt;
+      if (known && deep.seen[m] && glm::vec3(*known) != glm::vec3(deep.value[m])) return false;
+      // A material never met deep inside: unknown, unless the table knows it, it is air (a material
+      // that fills the box leaves no air inside it) or opaque (no ray goes on in it).
+      if (!deep.seen[m] && m > 0 && !opaque && !known) return false;
+      if (deep.seen[m] || known) store(result.media[m], deep.seen[m] ? deep.value[m] : *known);
     }
     return true;
   };
-  result.sigma_a_constant = constantIn(volume.find("sigma_a"), 3, [](MaterialMedium& medium, const std::array<float, 3>& x) {
-    medium.sigma_a = glm::dvec3(x[0], x[1], x[2]);
-  });
-  result.scatter_constant = constantIn(volume.find("scatter"), 2, [](MaterialMedium& medium, const std::array<float, 3>& x) {
-    medium.scatter = glm::dvec2(x[0], x[1]);
-  });
+  result.sigma_a_constant = constantIn(
+      volume.find("sigma_a"), [](const InterfaceSlot& s) { return s.sigma_a; },
+      [](MaterialMedium& medium, const glm::dvec3& x) { medium.sigma_a = x; });
+  result.scatter_constant = constantIn(
+      volume.find("scatter"), [](const InterfaceSlot&) { return std::optional<glm::dvec3>(); },
+      [](MaterialMedium& medium, const glm::dvec3& x) { medium.scatter = glm::dvec2(x); });
   if (!result.sigma_a_constant)
     for (MaterialMedium& m : result.media) m.sigma_a = glm::dvec3(0.0);
   if (!result.scatter_constant)

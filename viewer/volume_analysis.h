@@ -48,7 +48,7 @@ bool absorbingRegion(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi);
 // material with no such voxel (a wall thinner than two voxels), or whose voxels there disagree (two
 // objects of one n and different σa share a slot; smoke in the air), makes the field vary.
 // Opaque slots stop rays and are not looked at.
-constexpr double kMediumDepthVoxels = 1.0;
+constexpr double kMediumDepthVoxels = kDeepVoxels;
 struct MaterialMedium {
   glm::dvec3 sigma_a{0.0};
   glm::dvec2 scatter{0.0};  // albedo ω̂, Henyey–Greenstein g

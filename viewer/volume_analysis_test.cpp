@@ -232,6 +232,18 @@ TEST(SlotMedia, VaryWhereAMaterialDisagreesWithItselfOrIsNeverDeep) {
     EXPECT_FALSE(media.sigma_a_constant);
     EXPECT_FALSE(media.scatter_constant);
   }
+  {  // the thin slot with its σa in the slot table (the voxelizer records it): known, not its scatter
+    SharpSlabs slabs({1, 2, 3}, {0.5f, 0, 0}, {0.2f, 0.3f}, {0, 0}, 7.5);
+    slabs.table.slots[1].sigma_a = glm::dvec3(0.5, 0.0, 0.0);
+    const SlotMedia media = slotMedia(slabs.volume, slabs.table);
+    EXPECT_TRUE(media.sigma_a_constant);
+    EXPECT_EQ(media.media[2].sigma_a, glm::dvec3(0.5, 0.0, 0.0));
+    EXPECT_FALSE(media.scatter_constant);
+    // A table that disagrees with the deep voxels of a thick slot: the field decides.
+    SharpSlabs thick({1, 2, 3}, {0.5f, 0, 0}, {0.2f, 0.3f}, {0, 0});
+    thick.table.slots[0].sigma_a = glm::dvec3(1.0, 2.0, 3.5);
+    EXPECT_FALSE(slotMedia(thick.volume, thick.table).sigma_a_constant);
+  }
   {  // an opaque slot is not read, whatever it holds
     SharpSlabs slabs({1, 2, 3}, {0.5f, 0, 0}, {0.2f, 0.3f}, {0, 0});
     slabs.table.slots[0].opaque = true;
