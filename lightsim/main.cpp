@@ -17,6 +17,7 @@
 #include "core/atomic_file.h"
 #include "core/cli.h"
 #include "core/error.h"
+#include "core/interfaces.h"
 #include "core/progress.h"
 #include "core/stopwatch.h"
 #include "core/volume.h"
@@ -177,6 +178,7 @@ int run(int argc, char** argv) {
   Volume volume = readVolume(input);
   volume.require("ior", 1, input);
   volume.require("ior_grad", 3, input);
+  interfaceTable(volume, input);  // a malformed table is named with the file, before any work
   const VolumeDefaults defaults = volumeDefaults(volume.has("interfaces"));
   if (max_depth->count() == 0) options.max_depth = defaults.max_depth;
   if (split->count() == 0) options.split_voxels = defaults.split_voxels;

@@ -208,6 +208,10 @@ TEST(LightsimCli, BadInputExitsTwo) {
   Volume v = readVolume(dir / "ball.vol.json");
   v.fields.erase("ior_grad");
   writeVolume(v, dir / "nograd.vol.json");
+  makeSphere(dir, true);
+  Volume bad_slot = readVolume(dir / "sharp.vol.json");
+  bad_slot.metadata["interfaces"]["slots"][0]["sigma_a"] = {0.2, -0.4, 0.8};
+  writeVolume(bad_slot, dir / "bad_slot.vol.json");
   // Hostile manifests (issue "Reliability"): a key nested 10⁶ deep, a number beyond double.
   {
     const std::string text = readFile(dir / "ball.vol.json");
@@ -229,6 +233,8 @@ TEST(LightsimCli, BadInputExitsTwo) {
       {{"ball.vol.json", "-o", "x.vol.json", "--light", "directional:0,-1,0", "--power", "0,0,0"}, "--power"},
       {{"ball.vol.json", "-o", "x.vol.json", "--light", "directional:0,-1,0", "--power", "-1,1,1"}, "--power"},
       {{"nograd.vol.json", "-o", "x.vol.json", "--light", "directional:0,-1,0"}, "ior_grad"},
+      {{"bad_slot.vol.json", "-o", "x.vol.json", "--light", "directional:0,-1,0"},
+       "bad_slot.vol.json: interfaces.slots[0].sigma_a: must not be negative"},
       {{"missing.vol.json", "-o", "x.vol.json", "--light", "directional:0,-1,0"}, "missing.vol.json"},
       {{"ball.vol.json", "-o", "x.nrrd", "--light", "directional:0,-1,0"}, ".vol.json"},
       {{"ball.vol.json", "-o", "x.vol.json", "--light", "directional:0,-1,0", "--backend", "cuda"}, "--backend"},
