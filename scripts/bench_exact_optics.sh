@@ -21,7 +21,8 @@
 # sphere below it; ring_compare reports the fraction of each ring it sees).
 #
 # Usage: scripts/bench_exact_optics.sh [--out DIR] [--quick] [--build DIR] [--res "N..."]
-#                                      [--backend auto|gl|cpu] [--no-pov] [--exact FILE]
+#                                      [--backend auto|gl|cpu] [--no-pov] [--pov-counts "N..."]
+#                                      [--exact FILE]
 #   --out DIR      outputs (volumes, images, JSON, logs, table.md); default BUILD/bench-exact-optics
 #   --quick        N = 32 and 64, 10⁶ tracer rays, one POV-Ray photon count, one run each (a test)
 #   --build DIR    the build tree with voxelize, lightsim, viewer and tests/ring_compare (default build)
@@ -29,6 +30,8 @@
 #   --backend B    lightsim's back end (default auto: the GPU path on a GPU, the CPU twin on llvmpipe);
 #                  on a GPU server without a display, EIKONAL_GL=egl picks the OpenGL back end
 #   --no-pov       leave POV-Ray out (a machine without it)
+#   --pov-counts "N..."  POV-Ray's photon counts (default "100000 200000 400000 1600000"), e.g. to
+#                  find the fewest photons at a given error
 #   --exact FILE   the exact tracer's JSON of an earlier run instead of tracing again
 # Needs the benchmark tool: cmake --build build --target ring_compare (EIKONAL_BUILD_BENCHMARKS and
 # EIKONAL_BUILD_TESTS on). Installs the Debian package povray when `povray` is missing (as root).
@@ -37,7 +40,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build="$root/build"
 out=""
-quick=0 res_option="" backend=auto pov=1 exact_file=""
+quick=0 res_option="" backend=auto pov=1 exact_file="" pov_option=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --out) out=$2; shift 2 ;;
@@ -46,6 +49,7 @@ while [ $# -gt 0 ]; do
     --res) res_option=$2; shift 2 ;;
     --backend) backend=$2; shift 2 ;;
     --no-pov) pov=0; shift ;;
+    --pov-counts) pov_option=$2; shift 2 ;;
     --exact) exact_file=$(cd "$(dirname "$2")" && pwd)/$(basename "$2"); shift 2 ;;
     -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
     *) echo "bench_exact_optics.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
@@ -62,6 +66,7 @@ else
   resolutions="64 128"; rays=2e7; pov_counts="100000 200000 400000 1600000"; repeats=3
 fi
 resolutions=${res_option:-$resolutions}
+pov_counts=${pov_option:-$pov_counts}
 [ "$pov" = 1 ] || pov_counts=""
 smooth_res=${resolutions##* }
 # The camera of the viewer and of POV-Ray: low, to the side, looking at the caustic's centre.
