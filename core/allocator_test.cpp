@@ -25,6 +25,13 @@ TEST(Allocator, JemallocRunsWithHugePagesAsked) {
   size = sizeof metadata_thp;
   ASSERT_EQ(mallctl("opt.metadata_thp", &metadata_thp, &size, nullptr, 0), 0);
   EXPECT_STREQ(metadata_thp, "always");
+  // Freed memory stays for reuse (re-bakes fault nothing in afresh).
+  for (const char* option : {"opt.dirty_decay_ms", "opt.muzzy_decay_ms"}) {
+    ssize_t decay = 0;
+    size = sizeof decay;
+    ASSERT_EQ(mallctl(option, &decay, &size, nullptr, 0), 0) << option;
+    EXPECT_EQ(decay, -1) << option;
+  }
 }
 
 // operator new and malloc both go through it: a large vector's block is one jemalloc knows (its
