@@ -6,6 +6,8 @@
 //      x' = w/n², w' = ∇n/n, stepped with Euler (Eq. 6.1/6.2), RK2 (midpoint) or RK4
 //      (INTEGRATOR_EULER / _RK2 / _RK4), then w renormalised to n at the new position.
 //   2. Absorption: Φ ← Φ·exp(−σa(m_old)·Δs_m), Δs_m = Δt / n(m_old) (Eq. 4.11), Δt the step's time.
+//      MATERIAL_ABSORPTION (σa per material, sharp interfaces): Φ ← Φ·exp(−¼ Σ_c ∫σa ds) along the
+//      corners' paths, each piece with its material's σa (sharp.glsl advanceCornerSharp).
 //   3. Fresnel boundary tracking (docs/physics.md): enter a layer when |∇n(m_new)|·h > g_on, leave it
 //      when < g_off and keep the transmitted fraction 1 − R (boundaryReflectance, fresnel.glsl).
 // SHARP_INTERFACES (ALGORITHM.md "Sharp interfaces"; the CPU twin's stepPatch): each corner
