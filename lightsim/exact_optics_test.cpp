@@ -124,8 +124,10 @@ SphereBake bakeSphereOnFloor(int res, Stepping stepping = Stepping::Flight, Back
   const std::unique_ptr<Simulator> sim = simulatorFor(volume, backend);
   LightSpec light;  // straight down, irradiance 1
   SimulationOptions options;
-  options.max_depth = volumeDefaults(true).max_depth;  // lightsim's defaults with sharp interfaces
-  options.split_voxels = volumeDefaults(true).split_voxels;
+  const VolumeDefaults defaults = volumeDefaults(true, volume.grid);  // lightsim's, with sharp interfaces
+  options.max_depth = defaults.max_depth;
+  options.patch_voxels = defaults.patch_voxels;
+  options.split_voxels = defaults.split_voxels;
   options.free_flight = stepping != Stepping::Dt;  // lightsim's default: on
   if (stepping == Stepping::Straight) {
     options.volume_deposits = false;

@@ -101,11 +101,14 @@ int run(int argc, char** argv) {
       ->check(CLI::IsMember({"euler", "rk2", "rk4"}));
   app.add_option("--step", options.step_voxels, "time step: arc length per step in air, in voxels (default 0.5)")
       ->check(CLI::Range(0.01, 4.0));
-  app.add_option("--patch", options.patch_voxels, "initial patch edge in voxels (default 1)")->check(CLI::Range(0.05, 8.0));
+  CLI::Option* patch =
+      app.add_option("--patch", options.patch_voxels,
+                     "initial patch edge in voxels (default half the split length, at least 1)")
+          ->check(CLI::Range(0.05, 8.0));
   CLI::Option* split =
       app.add_option("--split", options.split_voxels,
-                     "split patches with an edge longer than this, in voxels (default 1.5 for a volume with sharp "
-                     "interfaces, 1 for a smoothed one)")
+                     "split patches with an edge longer than this, in voxels (default with sharp interfaces: the "
+                     "grid's longest side / 44, clamped to 1.5-3; 1 for a smoothed n)")
           ->check(CLI::Range(0.1, 16.0));
   app.add_option("--split-rule", split_rule,
                  "axis (default: halve only the directions whose edges are too long, 1x2 or 2x2) or quad "
@@ -179,8 +182,9 @@ int run(int argc, char** argv) {
   volume.require("ior", 1, input);
   volume.require("ior_grad", 3, input);
   interfaceTable(volume, input);  // a malformed table is named with the file, before any work
-  const VolumeDefaults defaults = volumeDefaults(volume.has("interfaces"));
+  const VolumeDefaults defaults = volumeDefaults(volume.has("interfaces"), volume.grid);
   if (max_depth->count() == 0) options.max_depth = defaults.max_depth;
+  if (patch->count() == 0) options.patch_voxels = defaults.patch_voxels;
   if (split->count() == 0) options.split_voxels = defaults.split_voxels;
   options.volume_deposits = volume_deposits == "on" ||
                             (volume_deposits == "auto" && viewerReadsVolumeLight(volume, options.receiver.has_value()));

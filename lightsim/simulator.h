@@ -4,6 +4,7 @@
 // GPU path and which serves as a fallback. makeSimulator (make_simulator.h) picks one.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <map>
@@ -15,6 +16,7 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/grid.h"
 #include "core/progress.h"
 #include "core/receiver_map.h"
 #include "core/volume.h"
@@ -108,18 +110,28 @@ struct SimulationOptions {
 
 // What `lightsim` takes, unless told otherwise, for a volume with sharp interfaces or a smoothed n
 // (its gradient field), and so the viewer's re-bake of a bake that does not record its options and
-// the tests that bake as `lightsim` does. With sharp interfaces a patch splits once an edge is past
-// 1.5 voxels, at most 4 times: between interfaces the rays are straight and the footprint deposits
-// need no finer wavefront, so the 128³ glass sphere bakes in 0.89 M patch-steps instead of 1.54 M
-// (split at 1 voxel) with its floor as close to exact optics (BENCHMARKS.md "Patches split at 1.5
-// voxels"); the silhouette's tears still split to a sixteenth of a voxel. A smoothed n bends
-// every ray: 1 voxel, 6 times.
+// the tests that bake as `lightsim` does.
+//
+// With sharp interfaces the rays are straight between them and the footprint deposits need no finer
+// wavefront than the shape of the objects asks for; the grid's box is fitted to them, so its longest
+// side N (voxels) measures them. A patch splits once an edge is past N/44 voxels, clamped to
+// [1.5, 3] (1.5 up to N = 66, 3 from N = 132), and starts half that wide (at least 1 voxel); at most
+// 4 splits. On a fine grid this keeps the patches as wide, against the objects, as on a 64³ one:
+// the 128³ glass sphere over its floor (N = 132) bakes in 0.50 M patch-steps instead of 1.03 M
+// (patches of 1 voxel split at 1.5), its floor as close to exact optics (mean ring deviation 1.9 %,
+// was 2.2 %), while on coarse grids, where the voxels are already that wide, nothing changes
+// (BENCHMARKS.md "Patches as wide as the objects ask"); the silhouette's tears still split to a
+// tenth of a voxel. A smoothed n bends every ray: patches of 1 voxel, split at 1, 6 times.
 struct VolumeDefaults {
+  double patch_voxels = 1.0;
   double split_voxels = 1.0;
   int max_depth = 6;
 };
-inline VolumeDefaults volumeDefaults(bool sharp_interfaces) {
-  return sharp_interfaces ? VolumeDefaults{1.5, 4} : VolumeDefaults{1.0, 6};
+inline VolumeDefaults volumeDefaults(bool sharp_interfaces, const GridSpec& grid) {
+  if (!sharp_interfaces) return VolumeDefaults{1.0, 1.0, 6};
+  const int longest = std::max(grid.dims.x, std::max(grid.dims.y, grid.dims.z));
+  const double split = std::clamp(static_cast<double>(longest) / 44.0, 1.5, 3.0);
+  return VolumeDefaults{std::max(1.0, 0.5 * split), split, 4};
 }
 
 // What Simulator::run throws when SimulationOptions::cancel was set: the bake was abandoned.

@@ -47,8 +47,9 @@ std::vector<RebakeSource> rebakeSources(const LoadedScene& scene) {
     // What `lightsim --scene` takes when the manifest does not say (bakes before "bake_options").
     SimulationOptions defaults;
     defaults.free_flight = true;
-    const VolumeDefaults volume_defaults = volumeDefaults(volume.has("interfaces"));
+    const VolumeDefaults volume_defaults = volumeDefaults(volume.has("interfaces"), volume.grid);
     defaults.max_depth = volume_defaults.max_depth;
+    defaults.patch_voxels = volume_defaults.patch_voxels;
     defaults.split_voxels = volume_defaults.split_voxels;
     if (scene.scene.ground) {
       const glm::dmat4 to_volume = glm::inverse(object.object_to_world);

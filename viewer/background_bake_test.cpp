@@ -84,7 +84,7 @@ TEST(BackgroundBake, ARebakeIsTheBakeLightsimMakesWithTheNewLight) {
   // A fresh bake of the unbaked ball with the new light and lightsim's options.
   const Volume ball = test_scenes::sharpVolume("procedural:sphere,r=1,center=0:1.5:0,ior=1.5", kBallRes, std::nullopt, 2.0);
   CpuSimulator simulator(ball);
-  const BakeResult fresh = simulator.run(directional(moved), lightsimOptions());
+  const BakeResult fresh = simulator.run(directional(moved), lightsimOptions(ball.grid));
   EXPECT_EQ(rebaked.volume.fields.at("irradiance").data, fresh.irradiance.data);
   EXPECT_EQ(rebaked.volume.fields.at("light_dir").data, fresh.light_dir.data);
   ASSERT_EQ(rebaked.volume.receivers.size(), 1u);
@@ -197,7 +197,7 @@ TEST(BackgroundBake, TheNewestRequestLandsAndAStaleBakeIsCancelled) {
 TEST(BackgroundBake, ACancelledRunThrowsAndASetFlagStopsItAtOnce) {
   const Volume ball = test_scenes::sharpVolume("procedural:sphere,r=1,center=0:1.5:0,ior=1.5", 16, std::nullopt, 2.0);
   CpuSimulator simulator(ball);
-  SimulationOptions options = lightsimOptions();
+  SimulationOptions options = lightsimOptions(ball.grid);
   std::atomic<bool> cancel{true};
   options.cancel = &cancel;
   EXPECT_THROW(simulator.run(directional({0, -1, 0}), options), BakeCancelled);

@@ -16,10 +16,12 @@ namespace eik::test_scenes {
 // n = 1.5) whose lowest point is 0.5 above the floor (y = 0, the receiver, half extent 1.6).
 constexpr int kBallRes = 32;
 
-inline SimulationOptions lightsimOptions() {
+inline SimulationOptions lightsimOptions(const GridSpec& grid) {
   SimulationOptions options;
-  options.max_depth = volumeDefaults(true).max_depth;  // lightsim's defaults with sharp interfaces
-  options.split_voxels = volumeDefaults(true).split_voxels;
+  const VolumeDefaults defaults = volumeDefaults(true, grid);  // lightsim's, with sharp interfaces
+  options.max_depth = defaults.max_depth;
+  options.patch_voxels = defaults.patch_voxels;
+  options.split_voxels = defaults.split_voxels;
   options.free_flight = true;  // lightsim's default
   ReceiverSpec floor;
   floor.half_extent = 1.6;
@@ -41,7 +43,7 @@ inline glm::dvec3 sunAt(double azimuth_deg) { return lightDirectionFromAngles(az
 // as a one-object scene with the floor as its ground.
 inline LoadedScene bakedScene(const LightSpec& light, int res = kBallRes) {
   Volume volume = test_scenes::sharpVolume("procedural:sphere,r=1,center=0:1.5:0,ior=1.5", res, std::nullopt, 2.0);
-  const SimulationOptions options = lightsimOptions();
+  const SimulationOptions options = lightsimOptions(volume.grid);
   CpuSimulator simulator(volume);
   applyBake(volume, simulator.run(light, options), light);
   volume.metadata["bake_options"] = bakeOptionsToJson(options);
