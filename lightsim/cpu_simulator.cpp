@@ -165,6 +165,7 @@ struct SharpUpdate {
   int transmitted_mask = 0;
   int met_mask = 0;        // corners that met an interface (refracted, reflected or were stopped)
   int reflections = 0;     // total internal reflections, all corners
+  int reflected_mask = 0;  // corners that were totally reflected
   glm::dvec3 optical_depth{0.0};  // ¼ Σ_c ∫σa ds (σa per material; else 0)
 };
 SharpUpdate updateCornersSharp(Patch& patch, PatchSamples& samples, const StepContext& ctx, double dt) {
@@ -176,6 +177,7 @@ SharpUpdate updateCornersSharp(Patch& patch, PatchSamples& samples, const StepCo
     u.met_interface |= met;
     if (met) u.met_mask |= 1 << c;
     u.reflections += cc.reflected;
+    if (cc.reflected > 0) u.reflected_mask |= 1 << c;
     u.blocked += cc.blocked ? 1 : 0;
     if (cc.transmitted > 0) u.transmitted_mask |= 1 << c;
     u.transmittance *= std::pow(cc.transmittance, 0.25);
@@ -200,10 +202,10 @@ double sharpStepTime(const Patch& patch, const StepContext& ctx) {
 // A patch meets an interface with some corners and not yet with the others. It will tear — the
 // others pass the object by (its silhouette), or meet another surface — unless each of them finds
 // the surface just crossed ahead on its straight ray, within a few patch sizes.
-bool willTear(const Patch& patch, const SharpUpdate& u, const VolumeSampler& sampler, double reach) {
+bool willTear(const Patch& patch, int met_mask, const VolumeSampler& sampler, double reach) {
   int slot = -1;
   for (int c = 0; c < 4; ++c) {
-    if (u.met_mask & (1 << c)) continue;
+    if (met_mask & (1 << c)) continue;
     InterfaceHit hit;
     const glm::dvec3 d = glm::normalize(patch.w[c]);
     if (!findInterface(sampler, patch.x[c], patch.x[c] + reach * d, patch.medium[c], hit)) return true;
@@ -331,8 +333,10 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
     patch.reflections += crossing.reflections;
     if (crossing.met_interface && oneMedium(before)) {
       const bool stretched = splitAxes(patch, kTearFactor * threshold, options.split_rule).any();
-      const bool first_touch = crossing.met_mask != 0xF;
-      const bool tears = stretched || (first_touch && willTear(patch, crossing, sampler, 4.0 * std::max(patch.longestEdge(), h)));
+      // Corners totally reflected at this surface in earlier steps have met it already.
+      const int met = crossing.met_mask | before.reflected;
+      const bool first_touch = met != 0xF;
+      const bool tears = stretched || (first_touch && willTear(patch, met, sampler, 4.0 * std::max(patch.longestEdge(), h)));
       if (tears && patch.depth >= options.max_depth) {
         // Torn at the depth limit: its corners now fan out over both sides of an edge or a
         // silhouette, and its interior says nothing about where its light goes. It dies here
@@ -385,6 +389,10 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
       patch.flux *= crossing.transmittance;
       patch.reflect_pending = 1.0 - (1.0 - patch.reflect_pending) * crossing.transmittance;
     }
+    // A total reflection is through once all four corners have reflected (or the patch flies:
+    // no surface is near).
+    patch.reflected |= crossing.reflected_mask;
+    if (patch.reflected == 0xF || flight > 0.0) patch.reflected = 0;
     patch.crossed |= crossing.transmitted_mask;
     if (patch.crossed == 0xF) {
       // Every corner is through: the reflected wavefront leaves the interface now (bounces).
@@ -401,6 +409,7 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
         result.reflection->bounce = patch.bounce + 1;
         result.reflection->reflect_pending = 0.0;
         result.reflection->crossed = 0;
+        result.reflection->reflected = 0;
         result.reflection->t_fresnel = 1.0;
       }
       patch.crossed = 0;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
@@ -351,9 +352,13 @@ TEST(ExactOpticsSphere, TheGpuPathFliesAndTakesStraightStepsAsTheTwinDoes) {
     EXPECT_NEAR(gpu.rings.irradiance[k] / cpu.rings.irradiance[k], 1.0, 0.01) << "ring " << k;
   EXPECT_NEAR(static_cast<double>(gpu.stats.total_patches), static_cast<double>(cpu.stats.total_patches),
               0.02 * static_cast<double>(cpu.stats.total_patches));
-  // The last patch alive may die a step earlier or later (where it dies moves by rounding): 2 steps
-  // on llvmpipe; NVIDIA's arithmetic (test_scenes::gpuArithmeticSlack) 38 against 42, hence 8.
-  EXPECT_NEAR(gpu.stats.steps, cpu.stats.steps, test_scenes::gpuArithmeticSlack() == 1.0 ? 2 : 8);
+  // The number of steps only within a factor 2 (without flights and straight steps it was 12×):
+  // the last patches alive are faint wavefronts that Fresnel reflected inside the ball and then, on
+  // the voxelised surface just past the critical angle, circle in it by total internal reflection
+  // until they count as trapped (kMaxTotalReflections); when that happens moves by rounding
+  // (measured 128 steps on the twin, 88 on llvmpipe, with 10⁻⁶ of the light).
+  EXPECT_LT(gpu.stats.steps, 2 * cpu.stats.steps);
+  EXPECT_LT(cpu.stats.steps, 2 * gpu.stats.steps);
   expectConvergesToExactOptics(bakeSphereOnFloor(32, Stepping::Straight, Backend::Gl), gpu);
 }
 
@@ -625,6 +630,102 @@ TEST(ExactOpticsPrism, BakedLightDirectionShowsTheMinimumDeviation) {
   std::printf("prism: baked light direction behind it (%.4f, %.4f, %.4f), minimum deviation %.3f°: %.3f° off\n",
               mean.x, mean.y, mean.z, glm::degrees(deviation), error_deg);
   EXPECT_LT(error_deg, 0.1);  // the bound
+}
+
+// The same prism lit straight onto its base (light along −z, normal to the face of a = 0): inside,
+// each half of the beam meets a side face at 60°, past the critical angle (41.8°), and is totally
+// reflected onto the other side face, which it leaves along that face's normal. Behind the exit
+// face's lower half the light must travel along the face normal with E = (1 − R₀)²·E₀, R₀ =
+// ((n − 1)/(n + 1))² (normal incidence twice; total reflection loses nothing, and keeps the beam's
+// width). A wavefront meets the reflecting face corner by corner over several steps: the corners
+// already reflected must not make it look torn (it was, and 16 % of the light entering the prism
+// died at the split depth).
+struct TirPrismProbe {
+  double e_error = 0.0, direction_error_deg = 0.0, killed = 0.0;
+  std::uint64_t patch_steps = 0;
+};
+TirPrismProbe bakeTirPrism(int res, Backend backend) {
+  const double n = 1.5, r0 = (n - 1.0) * (n - 1.0) / ((n + 1.0) * (n + 1.0));
+  const double expected_e = (1.0 - r0) * (1.0 - r0);
+  const double side = 0.7;
+  // Exit face a = 240° (normal (−sin 60°, 0, −½)): from its midpoint (u = ½, where the ray that met
+  // the reflecting face at the base's corner leaves) to the apex (u = 1).
+  const glm::dvec3 exit_normal(std::sin(glm::radians(240.0)), 0.0, std::cos(glm::radians(240.0)));
+  const double circumradius = side / std::sqrt(3.0);
+  const glm::dvec3 base_corner(-side / 2.0, 0.0, circumradius / 2.0), apex(0.0, 0.0, -circumradius);
+  // The prism taller than the box: no caps inside it.
+  const Volume volume = sharpVolume("procedural:prism,side=0.7,height=2,ior=1.5", res,
+                                    box({-0.5, -0.2, -0.6}, {0.5, 0.2, 0.4}));
+  const std::unique_ptr<Simulator> sim = simulatorFor(volume, backend);
+  LightSpec light;
+  light.direction = glm::dvec3(0.0, 0.0, -1.0);
+  const BakeResult r = sim->run(light, SimulationOptions{});
+  // Probe points in the shadow of the base, in the exit beam only: u ∈ [0.7, 0.85] along the exit
+  // face, 1.5–4 voxels out along its normal. The beam's edges are left out: at u = ½ and 1 its rays
+  // met the prism's edges, which the voxelised distances round within a voxel or so, and fan out
+  // from there (at 48³ they add 25 % at u = 0.6 and 15 % at u = 0.65).
+  const GridSpec& g = volume.grid;
+  const double h = voxelEdge(g);
+  glm::dvec3 dir_sum(0.0);
+  double e_sum = 0.0;
+  int count = 0;
+  for (int k = 0; k < g.dims.z; ++k)
+    for (int j = g.dims.y / 2 - 2; j <= g.dims.y / 2 + 2; ++j)
+      for (int i = 0; i < g.dims.x; ++i) {
+        const glm::dvec3 c = g.center(i, j, k);
+        const double t = glm::dot(c - apex, exit_normal);
+        const glm::dvec3 on_face = c - t * exit_normal;
+        const double u = glm::dot(on_face - base_corner, apex - base_corner) / (side * side);
+        if (t < 1.5 * h || t > 4.0 * h || u < 0.7 || u > 0.85) continue;
+        const float* e = r.irradiance.voxel(g.index(i, j, k));
+        const float* d = r.light_dir.voxel(g.index(i, j, k));
+        e_sum += e[0];
+        dir_sum += static_cast<double>(e[0]) * glm::dvec3(d[0], d[1], d[2]);
+        ++count;
+      }
+  EXPECT_GT(count, 10) << res;
+  TirPrismProbe probe;
+  const double mean_e = count > 0 ? e_sum / count : 0.0;
+  probe.e_error = mean_e / expected_e - 1.0;
+  probe.direction_error_deg = glm::degrees(std::acos(std::min(1.0, glm::dot(glm::normalize(dir_sum), exit_normal))));
+  // The light that met the prism: its base's width times the box's height, E₀ = 1.
+  const double into_prism = side * 0.4;
+  probe.killed = r.stats.flux_killed.x / into_prism;
+  probe.patch_steps = r.stats.total_patches;
+  std::printf("%d³, %s: prism with total internal reflection: E behind the exit face %.4f (exact %.4f, %+.2f %%), "
+              "direction %.3f° off its normal; killed %.2f %% of the light into the prism; %llu patch-steps\n",
+              res, r.stats.backend.c_str(), mean_e, expected_e, 100.0 * probe.e_error, probe.direction_error_deg,
+              100.0 * probe.killed, static_cast<unsigned long long>(r.stats.total_patches));
+  EXPECT_LT(r.stats.ledgerResidual(), backend == Backend::Cpu ? 1e-9 : 1e-5);
+  // What dies: the patches torn at the base's two edges, where the beam grazes the prism (a
+  // sixteenth of a voxel each side at the depth limit), and at the apex. Measured 0.2 % (32³)
+  // and 0.06 % (48³); before the corners already reflected counted as met, 12 % and 16 %.
+  EXPECT_LT(probe.killed, 0.01) << res;
+  return probe;
+}
+
+TEST(ExactOpticsPrism, TotalInternalReflectionKeepsTheWavefrontWhole) {
+  const TirPrismProbe coarse = bakeTirPrism(32, Backend::Cpu), fine = bakeTirPrism(48, Backend::Cpu);
+  // The exit beam: at 48³ within 4 % of (1 − R₀)² and 1° of the face normal (measured +2.7 %,
+  // 0.57°: light the rounded edges fan out still reaches into the probe), closer than at 32³
+  // (+14.9 %, 2.3°): the discretisation converges. A beam that lost its torn patches, or that the
+  // reflection widened or narrowed, would be off by far more (it was −47 % and 12° off, in 55 M
+  // patch-steps instead of 1.7 M); one that left by the wrong face, or unrefracted, by tens of
+  // degrees.
+  EXPECT_LT(std::abs(fine.e_error), 0.04);
+  EXPECT_LT(std::abs(fine.e_error), std::abs(coarse.e_error));
+  EXPECT_LT(fine.direction_error_deg, 1.0);
+  EXPECT_LT(fine.direction_error_deg, coarse.direction_error_deg);
+}
+
+// The GPU path keeps the reflected corners the same way (update.frag, the patch's META): the same
+// exit beam as the twin's within 1 % (GL against the CPU twin) at 24³.
+TEST(ExactOpticsPrism, TheGpuPathKeepsTotallyReflectedWavefrontsWhole) {
+  const TirPrismProbe cpu = bakeTirPrism(24, Backend::Cpu), gpu = bakeTirPrism(24, Backend::Gl);
+  EXPECT_NEAR((1.0 + gpu.e_error) / (1.0 + cpu.e_error), 1.0, 0.01);
+  EXPECT_NEAR(gpu.direction_error_deg, cpu.direction_error_deg, 0.2);
+  EXPECT_NEAR(static_cast<double>(gpu.patch_steps), static_cast<double>(cpu.patch_steps),
+              0.01 * test_scenes::gpuArithmeticSlack() * static_cast<double>(cpu.patch_steps));
 }
 
 // ---------------------------------------------------------------------------------------------

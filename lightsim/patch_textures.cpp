@@ -32,6 +32,7 @@ PatchTexels packPatch(const Patch& p, PatchLayout layout) {
     int media = 0;
     for (std::size_t c = 0; c < 4; ++c) media |= (p.medium[c] + 1) << (3 * c);
     media |= p.crossed << 12;
+    media |= p.reflected << 16;  // < 2²⁰: exact in float
     t[7] = glm::vec4(static_cast<float>(p.depth + 64.0 * (std::min(p.reflections, 255) + 256 * p.bounce)),
                      static_cast<float>(media), static_cast<float>(p.reflect_pending), static_cast<float>(p.t_fresnel));
   } else {
@@ -58,6 +59,7 @@ Patch unpackPatch(const PatchTexels& t, PatchLayout layout) {
     const int media = static_cast<int>(std::lround(t[7].y));
     for (std::size_t c = 0; c < 4; ++c) p.medium[c] = ((media >> (3 * c)) & 7) - 1;
     p.crossed = (media >> 12) & 15;
+    p.reflected = (media >> 16) & 15;
     p.reflect_pending = t[7].z;
     const double event = std::floor(static_cast<double>(t[7].w) / 2.0);  // a stored list has none
     p.t_fresnel = static_cast<double>(t[7].w) - 2.0 * event;

@@ -9,8 +9,9 @@
 //   6           FLUX     (Φ.rgb, A₀)
 //   7           META     (depth, n_in, cos_in, T_fresnel of the last step)
 //                        with sharp interfaces (PatchLayout::Sharp, SHARP_INTERFACES in GLSL):
-//                        (depth + 64·(reflections + 256·bounce), Σ (medium_c + 1)·8^c + 4096·crossed,
-//                         reflect_pending, T_fresnel + 2·event) — all integers exact in float
+//                        (depth + 64·(reflections + 256·bounce), Σ (medium_c + 1)·8^c + 4096·crossed
+//                         + 65536·reflected, reflect_pending, T_fresnel + 2·event) — all integers
+//                         exact in float
 //
 // Patch k lives at texel mortonTexel(k) (x from the even bits of k, y from the odd ones). That is
 // the order in which a histogram pyramid is descended with the child order (0,0), (1,0), (0,1),

@@ -388,6 +388,7 @@ int splitPatch(const Patch& parent, const VolumeSampler& sampler, SplitAxes axes
     child.t_fresnel = parent.t_fresnel;
     child.reflect_pending = parent.reflect_pending;
     child.crossed = parent.crossed;
+    child.reflected = parent.reflected;
     child.bounce = parent.bounce;
     areas[j] = child.area();
     child.area0 = areas[j];

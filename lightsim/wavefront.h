@@ -51,6 +51,9 @@ struct Patch {
   std::array<int, 4> medium{-1, -1, -1, -1};  // the material slot each corner is in (−1: air)
   double reflect_pending = 0.0;   // fraction of the flux reflected at the crossing in progress
   int crossed = 0;                // corners (bits 0–3) that crossed since that crossing began
+  // Corners (bits 0–3) totally reflected at the reflection in progress: a wavefront meets a surface
+  // corner by corner, over several steps, so those already reflected are through it, not torn off.
+  int reflected = 0;
   int bounce = 0;                 // reflections this wavefront has come through
   int reflections = 0;            // total internal reflections of its corners so far
 

@@ -63,6 +63,7 @@ void main() {
     r.bounce = p.bounce + 1;
     r.reflectPending = 0.0;
     r.crossed = 0;
+    r.reflected = 0;
     r.tFresnel = 1.0;
     p = r;
   } else if (p.crossed == 15) {

@@ -3,7 +3,7 @@
 //   [0..3] P0..P3 = (x_c, w_c.x)   [4] W01 = (w0.yz, w1.yz)   [5] W23 = (w2.yz, w3.yz)
 //   [6] FLUX = (Φ.rgb, A0)         [7] META = (depth, n_in, cos_in, T_fresnel)
 // With SHARP_INTERFACES META holds the sharp-interface state instead (patch_textures.h):
-//   META = (depth + 64·(reflections + 256·bounce), Σ (medium_c + 1)·8^c + 4096·crossed,
+//   META = (depth + 64·(reflections + 256·bounce), Σ (medium_c + 1)·8^c + 4096·crossed + 65536·reflected,
 //           reflect_pending, T_fresnel + 2·event)
 // where `event` is what the update pass tells the analysis about this step (SHARP_EVENT_*).
 // A list is read through a sampler array `uniform sampler2D NAME[8];` indexed with constants only
@@ -21,6 +21,7 @@ struct Patch {
 #ifdef SHARP_INTERFACES
   int medium[4];         // material slot of each corner (−1: air)
   int crossed;           // corners (bits 0–3) through the crossing in progress
+  int reflected;         // corners (bits 0–3) totally reflected at the reflection in progress
   float reflectPending;  // fraction of the flux reflected at that crossing
   int bounce;            // reflections this wavefront came through
   int reflections;       // total internal reflections of its corners so far
@@ -44,6 +45,7 @@ void unpackSharpMeta(vec4 m, inout Patch p) {
   int media = int(m.y + 0.5);
   for (int c = 0; c < 4; ++c) p.medium[c] = ((media >> (3 * c)) & 7) - 1;
   p.crossed = (media >> 12) & 15;
+  p.reflected = (media >> 16) & 15;
   p.reflectPending = m.z;
   float e = floor(m.w / 2.0);
   p.event = int(e);
@@ -55,6 +57,7 @@ vec4 packSharpMeta(Patch p) {
   int media = 0;
   for (int c = 0; c < 4; ++c) media |= (p.medium[c] + 1) << (3 * c);
   media |= p.crossed << 12;
+  media |= p.reflected << 16;
   return vec4(p.depth + 64.0 * float(min(p.reflections, 255) + 256 * p.bounce), float(media), p.reflectPending,
               p.tFresnel + 2.0 * float(p.event));
 }

@@ -128,7 +128,7 @@ void main() {
   // corner crosses the interfaces on its way.
   float transmittance = 1.0;
   vec3 opticalDepth = vec3(0.0);  // ¼ Σ_c ∫σa ds (MATERIAL_ABSORPTION)
-  int metMask = 0, transmittedMask = 0, blocked = 0, reflections = 0;
+  int metMask = 0, transmittedMask = 0, reflectedMask = 0, blocked = 0, reflections = 0;
   float flight = 0.0;
 #ifdef FREE_FLIGHT
   flight = freeFlightTime(p);
@@ -148,6 +148,7 @@ void main() {
       CornerCrossings cc = advanceCornerSharp(p.x[c], p.w[c], p.medium[c], stepTime);
       if (cc.transmitted > 0 || cc.reflected > 0 || cc.blocked) metMask |= 1 << c;
       reflections += cc.reflected;
+      if (cc.reflected > 0) reflectedMask |= 1 << c;
       blocked += cc.blocked ? 1 : 0;
       if (cc.transmitted > 0) transmittedMask |= 1 << c;
       transmittance *= pow(cc.transmittance, 0.25);
@@ -158,8 +159,10 @@ void main() {
   if (metMask != 0 && oneMedium(before)) {
     float splitLength = splitLengthOf(before, uSplitLength);
     bool stretched = splitAxesOf(p, kTearFactor * splitLength) != 0;
-    bool firstTouch = metMask != 15;
-    bool tears = stretched || (firstTouch && willTear(p, metMask, 4.0 * max(longestEdge(p), uVoxelEdge)));
+    // Corners totally reflected at this surface in earlier steps have met it already.
+    int met = metMask | before.reflected;
+    bool firstTouch = met != 15;
+    bool tears = stretched || (firstTouch && willTear(p, met, 4.0 * max(longestEdge(p), uVoxelEdge)));
     if (tears && p.depth >= uMaxDepth) {
       before.event = SHARP_EVENT_TORN;  // dies before it deposits anything
       writePatch(before);
@@ -189,6 +192,10 @@ void main() {
     p.flux *= transmittance;
     p.reflectPending = 1.0 - (1.0 - p.reflectPending) * transmittance;
   }
+  // A total reflection is through once all four corners have reflected (or the patch flies: no
+  // surface is near).
+  p.reflected |= reflectedMask;
+  if (p.reflected == 15 || flight > 0.0) p.reflected = 0;
   p.crossed |= transmittedMask;
   p.event = SHARP_EVENT_BLOCKED * blocked;
   writePatch(p);
