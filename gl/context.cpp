@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 
 #include "core/error.h"
@@ -81,6 +82,15 @@ bool displayAvailable() {
   const char* x11 = std::getenv("DISPLAY");
   const char* wayland = std::getenv("WAYLAND_DISPLAY");
   return (x11 && *x11) || (wayland && *wayland);
+}
+
+bool gpuDevicePresent() {
+  std::error_code error;
+  if (std::filesystem::exists("/dev/nvidia0", error)) return true;
+  for (std::filesystem::directory_iterator entry("/dev/dri", error), end; !error && entry != end;
+       entry.increment(error))
+    if (entry->path().filename().string().rfind("renderD", 0) == 0) return true;
+  return false;
 }
 
 bool isSoftwareRenderer(const GlInfo& info) {

@@ -4,7 +4,9 @@
 //   Cpu   the CPU twin (cpu_simulator.h);
 //   Auto  probes the OpenGL renderer: a hardware GPU gets the GPU path in the probed context; a
 //         software rasteriser (gl::isSoftwareRenderer: llvmpipe & co., where the twin is faster)
-//         or no OpenGL context at all gets the CPU twin. `report` is told the choice and why.
+//         or no OpenGL context at all gets the CPU twin. It takes the twin without loading a driver
+//         when OSMesa is asked for (software only) or the machine has no GPU device
+//         (gl::gpuDevicePresent). `report` is told the choice and why.
 // The caller runs the result through the Simulator interface only (simulator.h).
 #pragma once
 

@@ -79,7 +79,24 @@ TEST(MakeSimulatorTest, AutoTakesTheTwinOnASoftwareRasterizer) {
   const std::unique_ptr<Simulator> simulator = makeSimulator(volume, options);
   EXPECT_NE(dynamic_cast<CpuSimulator*>(simulator.get()), nullptr);
   ASSERT_EQ(reports.size(), 1u);
-  EXPECT_CONTAINS(reports[0], ", so the CPU twin (faster than a software rasterizer)");
+  EXPECT_EQ(reports[0], "OSMesa renders in software, so the CPU twin (faster than a software rasterizer)");
+}
+
+TEST(MakeSimulatorTest, AutoWithoutAGpuDeviceTakesTheTwinWithoutProbing) {
+  // EGL may be hardware, so it is probed where a GPU device exists; where none does (this
+  // project's CI machines), the twin is chosen without a context: had the probe run, the report
+  // would name the renderer it found ("llvmpipe ..., so the CPU twin ...").
+  if (gl::gpuDevicePresent()) GTEST_SKIP() << "this machine has a GPU device: the probe runs";
+  const Volume volume = smallSphere();
+  SimulatorBackendOptions options;
+  options.backend = SimulatorBackend::Auto;
+  options.gl = "egl";
+  std::vector<std::string> reports;
+  options.report = [&](const std::string& why) { reports.push_back(why); };
+  const std::unique_ptr<Simulator> simulator = makeSimulator(volume, options);
+  EXPECT_NE(dynamic_cast<CpuSimulator*>(simulator.get()), nullptr);
+  ASSERT_EQ(reports.size(), 1u);
+  EXPECT_EQ(reports[0], "no GPU device (/dev/dri/renderD*, /dev/nvidia0), so the CPU twin");
 }
 
 TEST(MakeSimulatorTest, AutoWithoutOpenGlTakesTheTwinAndSaysWhy) {
