@@ -23,20 +23,38 @@ struct Signature {
 
 }  // namespace
 
+namespace {
+
+QuietMap::FieldViews viewsOf(const GridSpec& grid, const std::vector<glm::vec4>& ior_grad,
+                             const std::vector<glm::vec4>& distances, const std::vector<glm::vec3>& sigma_a) {
+  QuietMap::FieldViews v;
+  if (ior_grad.size() != grid.count()) return v;
+  v.ior = &ior_grad[0].x;
+  v.ior_stride = 4;
+  v.grad = &ior_grad[0].y;
+  v.grad_stride = 4;
+  if (distances.size() == grid.count()) v.distances = &distances[0].x;
+  if (sigma_a.size() == grid.count()) v.sigma_a = &sigma_a[0].x;
+  return v;
+}
+
+}  // namespace
+
 QuietMap::QuietMap(const GridSpec& grid, const std::vector<glm::vec4>& ior_grad, const std::vector<glm::vec4>& distances,
                    const InterfaceTable& table, const std::vector<glm::vec3>& sigma_a)
-    : grid_(grid) {
+    : QuietMap(grid, viewsOf(grid, ior_grad, distances, sigma_a), table) {}
+
+QuietMap::QuietMap(const GridSpec& grid, const FieldViews& fields, const InterfaceTable& table) : grid_(grid) {
   const glm::ivec3 d = grid.dims;
-  if (d.x <= 0 || d.y <= 0 || d.z <= 0 || ior_grad.size() != grid.count()) return;
-  const bool sharp = !table.empty() && distances.size() == grid.count();
+  if (d.x <= 0 || d.y <= 0 || d.z <= 0 || !fields.ior || !fields.grad) return;
+  const bool sharp = !table.empty() && fields.distances;
   chooseBricks(sharp ? 100 : 160);
   const int slots = sharp ? static_cast<int>(table.slots.size()) : 0;
   auto signature = [&](std::size_t v) {
     Signature s;
-    const glm::vec4& g = ior_grad[v];
     bool graded = true;  // the n and ∇n fields are what a sample returns
     if (sharp) {
-      const glm::vec4& dist = distances[v];
+      const float* dist = fields.distances + v * fields.distances_stride;
       int material = -1;
       for (int k = 0; k < slots; ++k) {
         if (dist[k] == 0.0f) s.noisy = true;
@@ -49,10 +67,14 @@ QuietMap::QuietMap(const GridSpec& grid, const std::vector<glm::vec4>& ior_grad,
     }
     s.uses_n = graded;
     if (graded) {
-      s.n = g.x;
-      if (g.y != 0.0f || g.z != 0.0f || g.w != 0.0f) s.noisy = true;
+      s.n = fields.ior[v * fields.ior_stride];
+      const float* g = fields.grad + v * fields.grad_stride;
+      if (g[0] != 0.0f || g[1] != 0.0f || g[2] != 0.0f) s.noisy = true;
     }
-    if (!sigma_a.empty()) s.sigma = sigma_a[v];
+    if (fields.sigma_a) {
+      const float* sa = fields.sigma_a + v * fields.sigma_stride;
+      s.sigma = glm::vec3(sa[0], sa[1], sa[2]);
+    }
     return s;
   };
   std::vector<std::uint8_t> flag(static_cast<std::size_t>(bricks_.x) * bricks_.y * bricks_.z, 0);

@@ -21,6 +21,7 @@
 // is not; the table decides the rest.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -39,6 +40,19 @@ class QuietMap {
   // (empty without sharp interfaces) with their table; σa per voxel (empty: none).
   QuietMap(const GridSpec& grid, const std::vector<glm::vec4>& ior_grad, const std::vector<glm::vec4>& distances,
            const InterfaceTable& table, const std::vector<glm::vec3>& sigma_a);
+  // The same from strided views of the fields, grid.count() voxels each: a Volume's own fields, so
+  // that a sampler need not copy what it does not read (VolumeSampler).
+  struct FieldViews {
+    const float* ior = nullptr;        // n, every ior_stride floats
+    std::size_t ior_stride = 1;
+    const float* grad = nullptr;       // ∇n (3 floats), every grad_stride floats
+    std::size_t grad_stride = 3;
+    const float* distances = nullptr;  // the four slot distances, every distances_stride floats; null: none
+    std::size_t distances_stride = 4;
+    const float* sigma_a = nullptr;    // σa (3 floats), every sigma_stride floats; null: none
+    std::size_t sigma_stride = 3;
+  };
+  QuietMap(const GridSpec& grid, const FieldViews& fields, const InterfaceTable& table);
 
   // From flags of the voxels themselves (no neighbours compared): a box is quiet when no trilinear
   // sample in it touches a flagged voxel. VolumeSampler::absorberMap flags the absorbing voxels, so

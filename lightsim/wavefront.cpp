@@ -131,25 +131,30 @@ VolumeSampler::VolumeSampler(const Volume& volume)
       body(begin, std::min(n, begin + static_cast<std::size_t>(kChunk)));
     });
   };
-  ior_grad_.resize(n);
-  forChunks([&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      const float* g = grad.voxel(i);
-      ior_grad_[i] = glm::vec4(ior.data[i], g[0], g[1], g[2]);
-    }
-  });
   table_ = interfaceTable(volume);
+  const bool graded = std::any_of(table_.slots.begin(), table_.slots.end(), [](const InterfaceSlot& s) { return s.graded; });
+  // n and ∇n are read from the fields only where a sample returns them: everywhere without sharp
+  // interfaces, in graded materials with them (homogeneous materials and air have their own n).
+  // Elsewhere they are not copied (at 132³ that is 37 MB not written).
+  if (table_.empty() || graded) {
+    ior_grad_.resize(n);
+    forChunks([&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const float* g = grad.voxel(i);
+        ior_grad_[i] = glm::vec4(ior.data[i], g[0], g[1], g[2]);
+      }
+    });
+  }
+  const Field* d = nullptr;
   if (!table_.empty()) {
-    const Field& d = volume.require("interfaces", 4);
-    distances_.resize(n);
+    d = &volume.require("interfaces", 4);
     const int used = slotCount();
-    unused_distance_ = used < 4 ? d.voxel(0)[used] : 0.0f;
+    unused_distance_ = used < 4 ? d->voxel(0)[used] : 0.0f;
     std::vector<std::uint8_t> chunk_constant(static_cast<std::size_t>(chunks), 1);
     forChunks([&](std::size_t begin, std::size_t end) {
       bool constant = true;
-      for (std::size_t i = begin; i < end; ++i) {
-        const float* v = d.voxel(i);
-        distances_[i] = glm::vec4(v[0], v[1], v[2], v[3]);
+      for (std::size_t i = begin; i < end && constant; ++i) {
+        const float* v = d->voxel(i);
         for (int k = used; k < 4; ++k) constant = constant && v[k] == unused_distance_;
       }
       chunk_constant[begin / static_cast<std::size_t>(kChunk)] = constant ? 1 : 0;
@@ -161,7 +166,15 @@ VolumeSampler::VolumeSampler(const Volume& volume)
       forChunks([&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
           for (int k = 0; k < used; ++k)
-            used_distances_[i * static_cast<std::size_t>(used) + static_cast<std::size_t>(k)] = d.voxel(i)[k];
+            used_distances_[i * static_cast<std::size_t>(used) + static_cast<std::size_t>(k)] = d->voxel(i)[k];
+      });
+    } else {
+      distances_.resize(n);
+      forChunks([&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const float* v = d->voxel(i);
+          distances_[i] = glm::vec4(v[0], v[1], v[2], v[3]);
+        }
       });
     }
     // Each cell's material where its eight taps agree (materialAt).
@@ -175,7 +188,7 @@ VolumeSampler::VolumeSampler(const Volume& volume)
           const int x1 = std::min(x + 1, dims.x - 1);
           int inside = 0, outside = 0;  // bit k: slot k's distance < 0 (≥ 0) at some tap
           for (int t = 0; t < 8; ++t) {
-            const float* v = d.voxel(grid_.index(t & 1 ? x1 : x, t & 2 ? y1 : y, t & 4 ? z1 : z));
+            const float* v = d->voxel(grid_.index(t & 1 ? x1 : x, t & 2 ? y1 : y, t & 4 ? z1 : z));
             for (int k = 0; k < used; ++k) (v[k] < 0.0f ? inside : outside) |= 1 << k;
           }
           if ((inside & outside) != 0) continue;  // a slot changes sign in the cell
@@ -197,6 +210,22 @@ VolumeSampler::VolumeSampler(const Volume& volume)
     }
   }
   findMaterialAbsorption(volume);
+  // The quiet bricks, from the volume's own fields (what the copies above would give).
+  QuietMap::FieldViews views;
+  views.ior = ior.data.data();
+  views.grad = grad.data.data();
+  if (d) views.distances = d->data.data();
+  if (!sigma_a_.empty()) views.sigma_a = &sigma_a_[0].x;
+  quiet_ = QuietMap(grid_, views, table_);
+  // The smallest n: every material's and air's with sharp interfaces, the field's where it is read.
+  min_ior_ = std::numeric_limits<double>::infinity();
+  if (sharp()) {
+    min_ior_ = 1.0;  // air
+    for (const InterfaceSlot& slot : table_.slots)
+      if (!slot.graded) min_ior_ = std::min(min_ior_, slot.ior);
+  }
+  if (!sharp() || graded)
+    for (const float v : ior.data) min_ior_ = std::min(min_ior_, static_cast<double>(v));  // graded slots and smoothed n
 }
 
 void VolumeSampler::findMaterialAbsorption(const Volume& volume) {
@@ -239,7 +268,7 @@ int VolumeSampler::materialAt(const glm::dvec3& world) const {
 }
 
 glm::dvec4 VolumeSampler::distances(const glm::dvec3& world) const {
-  if (distances_.empty()) return glm::dvec4(0.0);
+  if (!sharp()) return glm::dvec4(0.0);
   const Taps3 taps = taps3(grid_, world, tap_scale_);
   switch (used_distances_.empty() ? 4 : slotCount()) {
     case 1: return interpolateUsed<1>(used_distances_, unused_distance_, grid_, taps);
@@ -257,7 +286,7 @@ glm::dvec4 VolumeSampler::materialOptics(int slot, const glm::dvec3& world) cons
   return interpolate<glm::dvec4>(ior_grad_, grid_, taps3(grid_, world, tap_scale_));
 }
 
-QuietMap VolumeSampler::quietMap() const { return QuietMap(grid_, ior_grad_, distances_, table_, sigma_a_); }
+
 
 QuietMap VolumeSampler::absorberMap() const {
   std::vector<std::uint8_t> flags(grid_.count(), 0);
@@ -266,19 +295,8 @@ QuietMap VolumeSampler::absorberMap() const {
   return QuietMap(grid_, flags);
 }
 
-double VolumeSampler::minIor() const {
-  double n = std::numeric_limits<double>::infinity();
-  if (sharp()) {
-    n = 1.0;  // air
-    for (const InterfaceSlot& slot : table_.slots)
-      if (!slot.graded) n = std::min(n, slot.ior);
-  }
-  for (const glm::vec4& g : ior_grad_) n = std::min(n, static_cast<double>(g.x));  // graded slots and smoothed n
-  return n;
-}
-
 glm::dvec3 VolumeSampler::interfaceNormal(int slot, const glm::dvec3& world) const {
-  if (distances_.empty()) return glm::dvec3(0.0);
+  if (!sharp()) return glm::dvec3(0.0);
   // Slot `slot`'s distance from a lookup's taps, as distances() interpolates it.
   const int used = used_distances_.empty() ? 4 : slotCount();
   auto distance = [&](const Taps3& t) {

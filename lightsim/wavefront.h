@@ -141,24 +141,24 @@ class VolumeSampler {
   // The outward unit normal of slot k's surface near `world`: ∇d_k by central differences of half a
   // voxel; (0, 0, 0) where the distance is flat (far outside the band).
   glm::dvec3 interfaceNormal(int slot, const glm::dvec3& world) const;
-  // The bricks where a straight step is exact (quiet_map.h), built from the fields held here.
-  QuietMap quietMap() const;
+  // The bricks where a straight step is exact (quiet_map.h), built with the sampler.
+  const QuietMap& quietMap() const { return quiet_; }
   // The voxels with σa ≠ 0 (any channel) as a QuietMap: its quiet boxes have no absorption.
   QuietMap absorberMap() const;
   // The smallest n of any material (sharp interfaces: every slot and air; else the ior field).
-  double minIor() const;
+  double minIor() const { return min_ior_; }
 
  private:
   GridSpec grid_;
   double h_ = 0.0;
   glm::dvec3 tap_scale_{1.0};  // dims/extent: world to voxel coordinates (taps3)
-  std::vector<glm::vec4> ior_grad_;  // (n, ∇n) per voxel
+  std::vector<glm::vec4> ior_grad_;  // (n, ∇n) per voxel; empty where no sample reads the fields
   std::vector<glm::vec3> sigma_a_;   // empty: no absorption
   bool absorption_per_material_ = false;
   std::array<glm::dvec3, kMaxInterfaceSlots> slot_sigma_a_{};
   void findMaterialAbsorption(const Volume& volume);
   InterfaceTable table_;
-  std::vector<glm::vec4> distances_; // empty without sharp interfaces
+  std::vector<glm::vec4> distances_; // empty without sharp interfaces or with used_distances_
   // The used slots' distances alone, slotCount() floats a voxel (a quarter of distances_ for one
   // slot: the lookup every corner makes each step reads that much less memory), with the unused
   // slots' one value; empty where those vary (then distances_ is read).
@@ -169,6 +169,8 @@ class VolumeSampler {
   // distance has one sign at all eight taps (then so has their trilinear blend), else kMixedCell.
   static constexpr std::int8_t kMixedCell = -2;
   std::vector<std::int8_t> cell_material_;
+  QuietMap quiet_;
+  double min_ior_ = 1.0;
 };
 
 // ---------------------------------------------------------------------------------------------
