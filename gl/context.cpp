@@ -106,6 +106,15 @@ GlBackend glBackendFromEnvironment(GlBackend fallback) {
   return parseGlBackend(value, "EIKONAL_GL");
 }
 
+DriverPreload::DriverPreload(const ContextOptions& options) {
+  const GlBackend requested = options.backend == GlBackend::Auto ? glBackendFromEnvironment() : options.backend;
+  if (requested == GlBackend::OSMesa || requested == GlBackend::Auto) thread_ = std::thread(detail::loadOSMesaLibrary);
+}
+
+DriverPreload::~DriverPreload() {
+  if (thread_.joinable()) thread_.join();
+}
+
 GlContext::GlContext(const ContextOptions& options) {
   serial_ = g_nextSerial++;
   debug_ = options.debug.value_or(debugRequestedByEnvironment());

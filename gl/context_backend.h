@@ -32,6 +32,8 @@ class ContextBackend {
 
 // Each throws RuntimeError("could not create an OpenGL 3.3 core context with ...: REASON").
 std::unique_ptr<ContextBackend> createOSMesaBackend(const ContextOptions& options, bool debug);
+// Loads libOSMesa (and with it Mesa and LLVM) if it is not yet: what createOSMesaBackend does first.
+void loadOSMesaLibrary();
 std::unique_ptr<ContextBackend> createEglBackend(const ContextOptions& options, bool debug);
 std::unique_ptr<ContextBackend> createWindowBackend(const ContextOptions& options, bool debug);
 void pollWindowEvents();

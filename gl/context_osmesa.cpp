@@ -133,6 +133,8 @@ class OSMesaBackend final : public ContextBackend {
 
 }  // namespace
 
+void loadOSMesaLibrary() { (void)osmesaLibrary(); }
+
 std::unique_ptr<ContextBackend> createOSMesaBackend(const ContextOptions& options, bool debug) {
   return std::make_unique<OSMesaBackend>(options, debug);
 }

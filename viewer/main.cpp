@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -170,6 +171,11 @@ int run(int argc, char** argv) {
   // The scene: a SCENE.json, or a volume alone with a camera that frames it.
   RenderSettings settings;
   settings.integrator = parseRayIntegrator(integrator_text);
+  // Rendering headless, the OpenGL driver loads while the scene is read.
+  gl::ContextOptions context_options;
+  context_options.backend = gl::parseGlBackend(gl_backend);
+  std::optional<gl::DriverPreload> preload;
+  if (!window_mode) preload.emplace(context_options);
   LoadedScene scene = loadScene(input);
   const bool is_scene = !scene.bare_volume;
   const ToneMapper tonemap =
@@ -224,8 +230,6 @@ int run(int argc, char** argv) {
     return runViewerWindow(scene, settings, camera, options);
   }
 
-  gl::ContextOptions context_options;
-  context_options.backend = gl::parseGlBackend(gl_backend);
   gl::GlContext context(context_options);
   gl::ShaderLibrary shaders;
   SceneRenderer renderer(shaders, scene, settings);
