@@ -167,7 +167,11 @@ TEST(ViewerCli, A1024CubedVolumeInTinyFilesIsRefusedBeforeItsMemory) {
         << r.output;
     EXPECT_FALSE(std::filesystem::exists(dir / args[2])) << args[2];
 #if !defined(__SANITIZE_ADDRESS__)
-    EXPECT_LT(r.peak_rss_kib, help.peak_rss_kib + 50 * 1000) << program << " (KiB; --help: " << help.peak_rss_kib << ")";
+    // 50 MB over --help, and for the viewer 60 MB more: it loads its OpenGL driver (OSMesa with Mesa
+    // and LLVM, about 55 MB resident) while it reads the volume. Either is far below the 4 GiB the
+    // sizes ask for.
+    const long margin_kib = (std::string(program) == VIEWER_EXE ? 110 : 50) * 1000;
+    EXPECT_LT(r.peak_rss_kib, help.peak_rss_kib + margin_kib) << program << " (KiB; --help: " << help.peak_rss_kib << ")";
 #endif
   }
 }
