@@ -230,9 +230,11 @@ int run(int argc, char** argv) {
     return runViewerWindow(scene, settings, camera, options);
   }
 
+  // The ground's texels on the CPU while the driver may still be loading, then the context.
+  const SceneRenderer::Preparation prepared = SceneRenderer::prepare(scene);
   gl::GlContext context(context_options);
   gl::ShaderLibrary shaders;
-  SceneRenderer renderer(shaders, scene, settings);
+  SceneRenderer renderer(shaders, scene, settings, &prepared);
   Image image = renderer.render(camera, size);
   ImageWriteOptions write;
   write.exposure_ev = exposure_ev;

@@ -72,9 +72,15 @@ struct SceneRenderer::Impl {
 
   // The object's receiver map of the scene's ground (core/receiver_map.h), if its volume has one in
   // the ground's plane (in the volume's own space), with the light it was baked with.
-  static void attachReceiver(Object& o, const LoadedObject& loaded, const SceneGroundSpec& ground) {
-    const glm::dvec3 point = glm::dvec3(o.to_volume * glm::dvec4(ground.point, 1.0));
-    const glm::dvec3 normal = glm::normalize(glm::transpose(glm::dmat3(o.to_world)) * ground.normal);
+  struct GroundReceiver {
+    const ReceiverMap* map = nullptr;
+    glm::vec4 light_pos{0.0f};
+    glm::vec3 light_power{0.0f};
+  };
+  static GroundReceiver findGroundReceiver(const LoadedObject& loaded, const SceneGroundSpec& ground) {
+    const glm::dmat4 to_volume = glm::inverse(loaded.object_to_world);
+    const glm::dvec3 point = glm::dvec3(to_volume * glm::dvec4(ground.point, 1.0));
+    const glm::dvec3 normal = glm::normalize(glm::transpose(glm::dmat3(loaded.object_to_world)) * ground.normal);
     for (const ReceiverMap& map : loaded.volume.receivers) {
       const double scale = map.pitch * 4.0;
       if (glm::dot(normal, map.normal) < 0.9999 || std::abs(glm::dot(point - map.point, map.normal)) > scale) continue;
@@ -84,32 +90,50 @@ struct SceneRenderer::Impl {
         const nlohmann::json& a = light.at(key);
         return glm::vec3(a.at(0).get<float>(), a.at(1).get<float>(), a.at(2).get<float>());
       };
+      GroundReceiver found;
+      found.map = &map;
       try {
         if (light.at("type") == "directional") {
-          o.receiver_light_pos = glm::vec4(glm::normalize(vec3Of("direction")), 0.0f);
-          o.receiver_light_power = vec3Of("irradiance");
+          found.light_pos = glm::vec4(glm::normalize(vec3Of("direction")), 0.0f);
+          found.light_power = vec3Of("irradiance");
         } else {
-          o.receiver_light_pos = glm::vec4(vec3Of("position"), 1.0f);
-          o.receiver_light_power = vec3Of("intensity");
+          found.light_pos = glm::vec4(vec3Of("position"), 1.0f);
+          found.light_power = vec3Of("intensity");
         }
       } catch (const nlohmann::json::exception&) {
         throw InputError(loaded.source, "light", "the baked light is malformed");
       }
-      o.receiver = map;  // with its irradiance, for the ground map
-      // Its shadow's edge to the pixel (shadow_edge.h): directional light, sharp interfaces.
-      ReceiverLayer layer{&o.receiver, o.to_volume, o.to_world, glm::dvec4(o.receiver_light_pos),
-                          glm::dvec3(o.receiver_light_power)};
-      const std::vector<float> clearance =
-          o.receiver_light_pos.w == 0.0f ? shadowClearance(loaded.volume, map, glm::dvec3(o.receiver_light_pos))
-                                          : std::vector<float>();
-      o.receiver_texture = gl::Texture2D(map.texels, gl::TextureFormat::RGBA32F, receiverTexels(layer, clearance), 4);
-      o.has_receiver = true;
-      return;
+      return found;
     }
+    return {};
+  }
+
+  // The receiver texture's texels: the map with its shadow's edge to the pixel (shadow_edge.h:
+  // directional light, sharp interfaces). No GL: SceneRenderer::prepare runs it before a context.
+  static std::vector<float> groundTexels(const LoadedObject& loaded, const GroundReceiver& found) {
+    const glm::dmat4 to_volume = glm::inverse(loaded.object_to_world);
+    ReceiverLayer layer{found.map, to_volume, loaded.object_to_world, glm::dvec4(found.light_pos),
+                        glm::dvec3(found.light_power)};
+    const std::vector<float> clearance =
+        found.light_pos.w == 0.0f ? shadowClearance(loaded.volume, *found.map, glm::dvec3(found.light_pos))
+                                  : std::vector<float>();
+    return receiverTexels(layer, clearance);
+  }
+
+  static void attachReceiver(Object& o, const LoadedObject& loaded, const SceneGroundSpec& ground,
+                             const std::vector<float>* prepared) {
+    const GroundReceiver found = findGroundReceiver(loaded, ground);
+    if (!found.map) return;
+    o.receiver_light_pos = found.light_pos;
+    o.receiver_light_power = found.light_power;
+    o.receiver = *found.map;  // with its irradiance, for the ground map
+    o.receiver_texture = gl::Texture2D(found.map->texels, gl::TextureFormat::RGBA32F,
+                                       prepared ? *prepared : groundTexels(loaded, found), 4);
+    o.has_receiver = true;
   }
 
   // One object's textures, bounds and shader defines, from its volume (the constructor, replaceVolume).
-  Object makeObject(const LoadedObject& loaded) const {
+  Object makeObject(const LoadedObject& loaded, const std::vector<float>* prepared_texels = nullptr) const {
     loaded.volume.require("ior", 1, loaded.source);
     loaded.volume.require("ior_grad", 3, loaded.source);
     Object o;
@@ -131,7 +155,7 @@ struct SceneRenderer::Impl {
       throw RuntimeError("viewer: expected ior and ior_grad together in one RGBA texture");
     const InterfaceTable table = interfaceTable(loaded.volume, loaded.source);
     o.defines = interfaceDefines(table) + slotMediumDefines(slotMedia(loaded.volume, table));
-    if (scene.ground) attachReceiver(o, loaded, *scene.ground);
+    if (scene.ground) attachReceiver(o, loaded, *scene.ground, prepared_texels);
     if (o.has_receiver) o.defines += "#define HAS_RECEIVER 1\n";
     const std::vector<float> bricks = homogeneousBricks(loaded.volume, o.brick_dims);
     o.bricks = gl::Texture3D(o.brick_dims, gl::TextureFormat::R32F, bricks, 1, gl::Sampling{gl::Filter::Nearest});
@@ -303,7 +327,19 @@ struct SceneRenderer::Impl {
   }
 };
 
-SceneRenderer::SceneRenderer(const gl::ShaderLibrary& shaders, const LoadedScene& scene, const RenderSettings& settings)
+SceneRenderer::Preparation SceneRenderer::prepare(const LoadedScene& scene) {
+  Preparation prepared;
+  prepared.ground_texels.resize(scene.objects.size());
+  if (!scene.scene.ground) return prepared;
+  for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+    const Impl::GroundReceiver found = Impl::findGroundReceiver(scene.objects[i], *scene.scene.ground);
+    if (found.map) prepared.ground_texels[i] = Impl::groundTexels(scene.objects[i], found);
+  }
+  return prepared;
+}
+
+SceneRenderer::SceneRenderer(const gl::ShaderLibrary& shaders, const LoadedScene& scene, const RenderSettings& settings,
+                             const Preparation* prepared)
     : impl_(std::make_unique<Impl>(shaders, scene)) {
   Impl& s = *impl_;
   s.settings = settings;
@@ -311,8 +347,10 @@ SceneRenderer::SceneRenderer(const gl::ShaderLibrary& shaders, const LoadedScene
   GLint max_units = 0;
   glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &max_units);
   int units = s.environment.kind() == EnvironmentKind::Map ? 1 : 0;
-  for (const LoadedObject& loaded : scene.objects) {
-    Impl::Object o = s.makeObject(loaded);
+  for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+    const std::vector<float>* texels = nullptr;
+    if (prepared && i < prepared->ground_texels.size() && prepared->ground_texels[i]) texels = &*prepared->ground_texels[i];
+    Impl::Object o = s.makeObject(scene.objects[i], texels);
     units += o.textures.layout().textureCount() + 1 + (o.has_receiver ? 1 : 0);
     s.objects.push_back(std::move(o));
   }

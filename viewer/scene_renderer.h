@@ -13,6 +13,8 @@
 #pragma once
 
 #include <memory>
+#include <optional>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -31,7 +33,17 @@ class SceneRenderer {
   // every object's volume and the environment map; InputError naming the file and field if a
   // volume lacks ior/ior_grad, is too large for the GPU, or the environment map cannot be read.
   // Keeps a reference to `shaders` (setSettings recompiles): it must outlive the renderer.
-  SceneRenderer(const gl::ShaderLibrary& shaders, const LoadedScene& scene, const RenderSettings& settings);
+  // What the constructor computes on the CPU and needs no GL context for: each object's ground
+  // texels (its receiver map with the shadow's edge, viewer/shadow_edge.h; 0.03 s for an 840² map
+  // on two cores), made beforehand — the headless viewer makes them while its driver loads
+  // (gl::DriverPreload). A constructor given them builds the renderer it would build without.
+  struct Preparation {
+    std::vector<std::optional<std::vector<float>>> ground_texels;  // per object; none: no map
+  };
+  static Preparation prepare(const LoadedScene& scene);
+
+  SceneRenderer(const gl::ShaderLibrary& shaders, const LoadedScene& scene, const RenderSettings& settings,
+                const Preparation* prepared = nullptr);
   ~SceneRenderer();
   SceneRenderer(const SceneRenderer&) = delete;
   SceneRenderer& operator=(const SceneRenderer&) = delete;

@@ -264,6 +264,28 @@ TEST_F(SharpViewerTest, TheShadowsEdgeIsWhereTheSunGrazesTheObject) {
   }
 }
 
+// The ground's texels made before the renderer (SceneRenderer::prepare, as the headless viewer
+// makes them while its driver loads) give the renderer it builds without them: the same image to
+// the bit, shadow edge and caustic included, for a sphere moved off the origin.
+TEST_F(SharpViewerTest, GroundTexelsPreparedBeforehandRenderTheSameImage) {
+  const Volume volume = bakedSphereOverAFloor(32);
+  Scene scene = floorScene(1);
+  scene.objects[0].translate = glm::dvec3(0.13, 0.0, -0.07);
+  LoadedScene loaded = sceneFromVolumes(scene, {volume});
+  const SceneRenderer::Preparation prepared = SceneRenderer::prepare(loaded);
+  ASSERT_EQ(prepared.ground_texels.size(), 1u);
+  ASSERT_TRUE(prepared.ground_texels[0].has_value()) << "the baked map lies in the ground's plane";
+  EXPECT_EQ(prepared.ground_texels[0]->size(), 4 * volume.receivers.at(0).texelCount());
+  const Camera camera{glm::dvec3(0.6, 1.2, 1.6), glm::dvec3(0.1, 0.0, 0.0), glm::dvec3(0, 1, 0), 40.0};
+  const Image without = SceneRenderer(*shaders_, loaded, RenderSettings{}).render(camera, {64, 64});
+  const Image with = SceneRenderer(*shaders_, loaded, RenderSettings{}, &prepared).render(camera, {64, 64});
+  ASSERT_EQ(with.pixels.size(), without.pixels.size());
+  EXPECT_EQ(with.pixels, without.pixels);
+  // A scene without a ground has nothing to prepare.
+  loaded.scene.ground.reset();
+  EXPECT_FALSE(SceneRenderer::prepare(loaded).ground_texels.at(0).has_value());
+}
+
 // Two such spheres side by side (x = ±0.4, their maps overlapping in |x| < 0.2): the ground is
 // shaded from one ground map, and shows at every point the direct light changed by each map that
 // reaches it — its irradiance less the 1 W/m² it was baked with — in their overlap, in either
