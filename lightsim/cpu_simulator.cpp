@@ -921,18 +921,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   }
   if (options.receiver) {
     // Planar irradiance: each texel's flux over its area.
-    const double inv_area = 1.0 / (receiver.pitch * receiver.pitch);
-    std::vector<glm::dvec3> texel_flux = std::move(*receiver_flux).resolve();
-    receiver.irradiance.resize(receiver.texelCount() * 3);
-    parallelFor(
-        0, static_cast<std::int64_t>(receiver.texelCount()),
-        [&](std::int64_t t64) {
-          const std::size_t t = static_cast<std::size_t>(t64);
-          glm::dvec3 flux = texel_flux[t];
-          if (t < direct_flux.size()) flux += direct_flux[t];
-          for (int c = 0; c < 3; ++c) receiver.irradiance[3 * t + static_cast<std::size_t>(c)] = static_cast<float>(flux[c] * inv_area);
-        },
-        4096);
+    receiver_flux->irradiance(direct_flux, 1.0 / (receiver.pitch * receiver.pitch), receiver.irradiance);
     bake.receivers.push_back(std::move(receiver));
   }
   stats.phase_seconds["update"] = t_update;

@@ -147,7 +147,8 @@ void depositRow(const ReceiverMap& map, const glm::dvec2* p, int n, const glm::d
 // Adds flux × area(polygon ∩ texel)/area(polygon) to the texels of rows [row_begin, row_end) for a
 // convex polygon of up to 4 vertices (a triangle, or a convex footprint whole), row by row.
 void depositConvex(const ReceiverMap& map, const glm::dvec2* polygon, int count, double area, const glm::dvec3& flux,
-                   std::vector<glm::dvec3>& texel_flux, int row_begin, int row_end) {
+                   const TexelRows& out) {
+  const int row_begin = out.row_begin, row_end = out.row_end;
   if (!(area > 0.0)) {
     // A degenerate footprint (all corners on a line or a point): its flux goes to the texel of its centre.
     glm::dvec2 centre(0.0);
@@ -155,7 +156,7 @@ void depositConvex(const ReceiverMap& map, const glm::dvec2* polygon, int count,
     const glm::dvec2 t = (centre - map.origin) / map.pitch;
     const int i = static_cast<int>(std::floor(t.x)), j = static_cast<int>(std::floor(t.y));
     if (i >= 0 && j >= std::max(0, row_begin) && i < map.texels.x && j < std::min(map.texels.y, row_end))
-      texel_flux[static_cast<std::size_t>(j) * static_cast<std::size_t>(map.texels.x) + static_cast<std::size_t>(i)] += flux;
+      out.row(j)[i] += flux;
     return;
   }
   double ylo = polygon[0].y, yhi = polygon[0].y;
@@ -172,7 +173,7 @@ void depositConvex(const ReceiverMap& map, const glm::dvec2* polygon, int count,
     int n = clipAgainst(buffer_a, count, buffer_b, 1, y0, -1.0);
     n = clipAgainst(buffer_b, n, buffer_a, 1, y1, 1.0);
     if (n < 3) continue;
-    depositRow(map, buffer_a, n, density, &texel_flux[static_cast<std::size_t>(j) * static_cast<std::size_t>(map.texels.x)]);
+    depositRow(map, buffer_a, n, density, out.row(j));
   }
 }
 
@@ -226,14 +227,13 @@ std::vector<glm::dvec3> directMapLight(const ReceiverMap& map, const LightSpec& 
 
 FootprintSums::FootprintSums(const ReceiverMap& map) : map_(map) {
   map_.irradiance.clear();
-  flux_.emplace_back(map.texelCount(), glm::dvec3(0.0));
   for (int k = 1; k <= kFootprintLevels; ++k) {
     ReceiverMap level = map_;
     level.pitch = map.pitch * static_cast<double>(1 << k);
     level.texels = (map.texels + glm::ivec2((1 << k) - 1)) / (1 << k);
-    flux_.emplace_back(level.texelCount(), glm::dvec3(0.0));
     coarse_.push_back(std::move(level));
   }
+  bands_.assign(kFootprintLevels + 1, std::vector<std::vector<glm::dvec3>>(static_cast<std::size_t>(bands())));
 }
 
 int FootprintSums::level(const std::array<glm::dvec2, 4>& f) const {
@@ -251,38 +251,69 @@ int FootprintSums::level(const std::array<glm::dvec2, 4>& f) const {
 void FootprintSums::deposit(const std::array<glm::dvec2, 4>& footprint, const glm::dvec3& flux, int band) {
   const int k = level(footprint);
   const int rows = kBandRows >> k;
-  depositFootprint(k == 0 ? map_ : coarse_[static_cast<std::size_t>(k - 1)], footprint, flux,
-                   flux_[static_cast<std::size_t>(k)], band * rows, (band + 1) * rows);
+  const ReceiverMap& level_map = k == 0 ? map_ : coarse_[static_cast<std::size_t>(k - 1)];
+  std::vector<glm::dvec3>& block = bands_[static_cast<std::size_t>(k)][static_cast<std::size_t>(band)];
+  if (block.empty()) block.assign(static_cast<std::size_t>(rows) * static_cast<std::size_t>(level_map.texels.x), glm::dvec3(0.0));
+  const int first = band * rows;
+  depositFootprint(level_map, footprint, flux, TexelRows{block.data(), level_map.texels.x, first, first, first + rows});
 }
 
-void FootprintSums::addCoarseLevels(std::vector<glm::dvec3>& out) const {
-  // Each texel adds the levels in the order k = 1, 2, ...: the same sums whatever the thread count.
+FootprintSums::RowSums FootprintSums::rowSums(int j) const {
+  const int band = j / kBandRows;
+  RowSums r;
+  const std::vector<glm::dvec3>& fine = bands_[0][static_cast<std::size_t>(band)];
+  if (!fine.empty()) r.level[0] = fine.data() + static_cast<std::size_t>(j - band * kBandRows) * static_cast<std::size_t>(map_.texels.x);
+  for (int k = 1; k <= kFootprintLevels; ++k) {
+    // A band of the map is a whole band of every level (kBandRows is a multiple of 2^k).
+    const std::vector<glm::dvec3>& block = bands_[static_cast<std::size_t>(k)][static_cast<std::size_t>(band)];
+    if (block.empty()) continue;  // its sums are 0 there
+    const int rows = kBandRows >> k;
+    r.level[k] = block.data() + static_cast<std::size_t>((j >> k) - band * rows) *
+                                    static_cast<std::size_t>(coarse_[static_cast<std::size_t>(k - 1)].texels.x);
+  }
+  return r;
+}
+
+glm::dvec3 FootprintSums::RowSums::flux(int i) const {
+  // The texel's own flux, then each coarser level's share over it, k = 1, 2, ... in order (the same
+  // sums whatever the thread count).
+  glm::dvec3 f = level[0] ? level[0][i] : glm::dvec3(0.0);
+  for (int k = 1; k <= kFootprintLevels; ++k)
+    if (level[k]) f += level[k][i >> k] * (1.0 / static_cast<double>(1 << (2 * k)));
+  return f;
+}
+
+std::vector<glm::dvec3> FootprintSums::resolve() const {
+  std::vector<glm::dvec3> out(map_.texelCount());
   parallelFor(
       0, map_.texels.y,
       [&](std::int64_t j64) {
         const int j = static_cast<int>(j64);
+        const RowSums sums = rowSums(j);
         glm::dvec3* row = out.data() + static_cast<std::size_t>(j) * static_cast<std::size_t>(map_.texels.x);
-        for (int k = 1; k <= kFootprintLevels; ++k) {
-          const ReceiverMap& level = coarse_[static_cast<std::size_t>(k - 1)];
-          const glm::dvec3* sums = flux_[static_cast<std::size_t>(k)].data() +
-                                   static_cast<std::size_t>(j >> k) * static_cast<std::size_t>(level.texels.x);
-          const double share = 1.0 / static_cast<double>(1 << (2 * k));
-          for (int i = 0; i < map_.texels.x; ++i) row[i] += sums[i >> k] * share;
+        for (int i = 0; i < map_.texels.x; ++i) row[i] = sums.flux(i);
+      },
+      16);
+  return out;
+}
+
+void FootprintSums::irradiance(const std::vector<glm::dvec3>& extra, double inv_area, std::vector<float>& out) const {
+  out.resize(map_.texelCount() * 3);
+  parallelFor(
+      0, map_.texels.y,
+      [&](std::int64_t j64) {
+        const int j = static_cast<int>(j64);
+        const RowSums sums = rowSums(j);
+        const std::size_t first = static_cast<std::size_t>(j) * static_cast<std::size_t>(map_.texels.x);
+        const glm::dvec3* direct = first < extra.size() ? extra.data() + first : nullptr;
+        float* row = out.data() + 3 * first;
+        for (int i = 0; i < map_.texels.x; ++i) {
+          glm::dvec3 flux = sums.flux(i);
+          if (direct) flux += direct[i];
+          for (int c = 0; c < 3; ++c) row[3 * i + c] = static_cast<float>(flux[c] * inv_area);
         }
       },
       16);
-}
-
-std::vector<glm::dvec3> FootprintSums::resolve() const& {
-  std::vector<glm::dvec3> out = flux_[0];
-  addCoarseLevels(out);
-  return out;
-}
-
-std::vector<glm::dvec3> FootprintSums::resolve() && {
-  std::vector<glm::dvec3> out = std::move(flux_[0]);
-  addCoarseLevels(out);
-  return out;
 }
 
 double triangleSquareOverlap(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c, const glm::dvec2& lo,
@@ -298,6 +329,12 @@ double triangleSquareOverlap(const glm::dvec2& a, const glm::dvec2& b, const glm
 
 void depositFootprint(const ReceiverMap& map, const std::array<glm::dvec2, 4>& f, const glm::dvec3& flux,
                       std::vector<glm::dvec3>& texel_flux, int row_begin, int row_end) {
+  depositFootprint(map, f, flux, TexelRows{texel_flux.data(), map.texels.x, 0, row_begin, row_end});
+}
+
+void depositFootprint(const ReceiverMap& map, const std::array<glm::dvec2, 4>& f, const glm::dvec3& flux,
+                      const TexelRows& out) {
+  const int row_begin = out.row_begin, row_end = out.row_end;
   // An axis-aligned rectangle (a patch straight down onto a level floor, as most of them are
   // outside the volume): its two triangles have equal shares and one density, so each texel gets
   // the density times the product of its overlaps along u and v.
@@ -321,9 +358,7 @@ void depositFootprint(const ReceiverMap& map, const std::array<glm::dvec2, 4>& f
         for (int i = i0; i <= i1; ++i) {
           const double x0 = map.origin.x + i * map.pitch;
           const double ox = std::min(hi.x, x0 + map.pitch) - std::max(lo.x, x0);
-          if (ox > 0.0)
-            texel_flux[static_cast<std::size_t>(j) * static_cast<std::size_t>(map.texels.x) + static_cast<std::size_t>(i)] +=
-                density * (ox * oy);
+          if (ox > 0.0) out.row(j)[i] += density * (ox * oy);
         }
       }
       return;
@@ -339,13 +374,13 @@ void depositFootprint(const ReceiverMap& map, const std::array<glm::dvec2, 4>& f
   const bool convex = (turns[0] > 0.0 && turns[1] > 0.0 && turns[2] > 0.0 && turns[3] > 0.0) ||
                       (turns[0] < 0.0 && turns[1] < 0.0 && turns[2] < 0.0 && turns[3] < 0.0);
   if (convex) {
-    depositConvex(map, f.data(), 4, total, flux, texel_flux, row_begin, row_end);
+    depositConvex(map, f.data(), 4, total, flux, out);
     return;
   }
   const double share = total > 0.0 ? a1 / total : 0.5;
   const glm::dvec2 t1[3] = {f[0], f[1], f[2]}, t2[3] = {f[0], f[2], f[3]};
-  depositConvex(map, t1, 3, a1, flux * share, texel_flux, row_begin, row_end);
-  depositConvex(map, t2, 3, a2, flux * (1.0 - share), texel_flux, row_begin, row_end);
+  depositConvex(map, t1, 3, a1, flux * share, out);
+  depositConvex(map, t2, 3, a2, flux * (1.0 - share), out);
 }
 
 }  // namespace eik

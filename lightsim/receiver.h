@@ -50,6 +50,20 @@ bool patchFootprint(const Patch& patch, const ReceiverMap& map, std::array<glm::
 void depositFootprint(const ReceiverMap& map, const std::array<glm::dvec2, 4>& footprint, const glm::dvec3& flux,
                       std::vector<glm::dvec3>& texel_flux, int row_begin = 0,
                       int row_end = std::numeric_limits<int>::max());
+// Texel rows of a map `width` texels wide held from `data` on, data[0] being the first texel of row
+// `first_row`; only rows [row_begin, row_end) are written. A whole map (first_row 0) or one band of
+// it (FootprintSums keeps a band only once something lands in it).
+struct TexelRows {
+  glm::dvec3* data = nullptr;
+  int width = 0;
+  int first_row = 0;
+  int row_begin = 0;
+  int row_end = 0;
+  glm::dvec3* row(int j) const { return data + static_cast<std::size_t>(j - first_row) * static_cast<std::size_t>(width); }
+};
+// The same into `rows`.
+void depositFootprint(const ReceiverMap& map, const std::array<glm::dvec2, 4>& footprint, const glm::dvec3& flux,
+                      const TexelRows& rows);
 
 // A directional light's light on the map where no followed patch carries it (ALGORITHM.md
 // "Receivers", direct light): per texel (W, texelCount() long), E_L·|L·n|·pitch² (the plane's
@@ -86,16 +100,26 @@ class FootprintSums {
   int bands() const { return (map_.texels.y + kBandRows - 1) / kBandRows; }
   // Each map texel's flux (W): its own plus its share of every coarser level's texel over it. The
   // rvalue form hands over the fine level's storage instead of copying it (a 1024² map: 25 MB).
-  std::vector<glm::dvec3> resolve() const&;
-  std::vector<glm::dvec3> resolve() &&;
+  std::vector<glm::dvec3> resolve() const;
+  // The map's irradiance (3 floats a texel): each texel's flux as resolve() gives it, plus
+  // `extra[t]` where extra holds it (directMapLight's), times inv_area — without a whole map of
+  // sums: the bands nothing landed in hold none.
+  void irradiance(const std::vector<glm::dvec3>& extra, double inv_area, std::vector<float>& out) const;
 
  private:
-  // Adds every coarser level's shares to `fine` (the fine level's sums), rows in parallel.
-  void addCoarseLevels(std::vector<glm::dvec3>& fine) const;
+  // Row j's sums on every level (null where the band holds none), and texel i's flux from them.
+  struct RowSums {
+    const glm::dvec3* level[kFootprintLevels + 1] = {};
+    glm::dvec3 flux(int i) const;
+  };
+  RowSums rowSums(int j) const;
 
-  ReceiverMap map_;                              // geometry only
-  std::vector<ReceiverMap> coarse_;              // level k ≥ 1 at index k − 1: pitch·2^k
-  std::vector<std::vector<glm::dvec3>> flux_;    // level k's per-texel flux
+  ReceiverMap map_;                      // geometry only
+  std::vector<ReceiverMap> coarse_;      // level k ≥ 1 at index k − 1: pitch·2^k
+  // Level k's per-texel flux by bands of kBandRows >> k rows (band b: its rows from b·(kBandRows >> k)),
+  // each band's made at the first footprint that lands in it (most of a map's bands never get one:
+  // its light is the direct light's, directMapLight).
+  std::vector<std::vector<std::vector<glm::dvec3>>> bands_;
 };
 
 // Area of the intersection of triangle (a, b, c) with the axis-aligned square [lo, hi] (exact,
