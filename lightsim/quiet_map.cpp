@@ -130,43 +130,53 @@ std::vector<std::uint8_t>::reference QuietMap::brickFlag(std::vector<std::uint8_
                    (static_cast<std::size_t>(y / brick_) + static_cast<std::size_t>(bricks_.y) * static_cast<std::size_t>(z / brick_))];
 }
 
-void QuietMap::buildClearance(const std::vector<std::uint8_t>& flag) {
-  // The chessboard distance transform in two raster passes over the 26 neighbours (exact for this
-  // metric): forward from the 13 bricks before each one, backward from the 13 after it.
+void QuietMap::buildClearance() {
+  // Each brick's chessboard distance to the nearest noisy brick is the least r whose cube of bricks
+  // within r of it (clipped to the grid) holds a noisy one, which the summed-area table tells in
+  // eight lookups. Along a row the distance changes by at most 1 from one brick to the next, so
+  // after a binary search at the row's first brick each brick takes one to three cubes. Rows in
+  // parallel (the raster passes of a distance transform are serial: 8 ms at 68³ against 1-2).
   const int nx = bricks_.x, ny = bricks_.y, nz = bricks_.z;
-  clearance_.assign(flag.size(), 255);
-  for (std::size_t i = 0; i < flag.size(); ++i)
-    if (flag[i]) clearance_[i] = 0;
-  auto at = [&](int x, int y, int z) -> std::uint8_t& {
-    return clearance_[static_cast<std::size_t>(x) + static_cast<std::size_t>(nx) * (static_cast<std::size_t>(y) + static_cast<std::size_t>(ny) * static_cast<std::size_t>(z))];
+  clearance_.assign(static_cast<std::size_t>(nx) * ny * nz, 255);
+  if (noisy_ == 0) return;
+  auto noisyWithin = [&](int x, int y, int z, int r) {
+    const int x0 = std::max(0, x - r), y0 = std::max(0, y - r), z0 = std::max(0, z - r);
+    const int x1 = std::min(nx, x + r + 1), y1 = std::min(ny, y + r + 1), z1 = std::min(nz, z + r + 1);
+    const std::uint32_t count = sat(x1, y1, z1) - sat(x0, y1, z1) - sat(x1, y0, z1) - sat(x1, y1, z0) +
+                                sat(x0, y0, z1) + sat(x0, y1, z0) + sat(x1, y0, z0) - sat(x0, y0, z0);
+    return count != 0;
   };
-  auto pass = [&](int sign) {
-    const int x0 = sign > 0 ? 0 : nx - 1, y0 = sign > 0 ? 0 : ny - 1, z0 = sign > 0 ? 0 : nz - 1;
-    for (int z = z0; z >= 0 && z < nz; z += sign)
-      for (int y = y0; y >= 0 && y < ny; y += sign)
-        for (int x = x0; x >= 0 && x < nx; x += sign) {
-          std::uint8_t& here = at(x, y, z);
-          if (here == 0) continue;
-          int best = here;
-          // The neighbours before (x, y, z) in this pass's raster order: the previous slice's nine,
-          // the previous row's three, the previous brick in the row.
-          for (int dz = -1; dz <= 0; ++dz)
-            for (int dy = -1; dy <= 1; ++dy)
-              for (int dx = -1; dx <= 1; ++dx) {
-                if (dz == 0 && (dy > 0 || (dy == 0 && dx >= 0))) continue;
-                const int qx = x + sign * dx, qy = y + sign * dy, qz = z + sign * dz;
-                if (qx < 0 || qy < 0 || qz < 0 || qx >= nx || qy >= ny || qz >= nz) continue;
-                best = std::min(best, at(qx, qy, qz) + 1);
-              }
-          here = static_cast<std::uint8_t>(std::min(best, 255));
+  parallelFor(
+      0, static_cast<std::int64_t>(ny) * nz,
+      [&](std::int64_t line) {
+        const int y = static_cast<int>(line % ny), z = static_cast<int>(line / ny);
+        std::uint8_t* row = clearance_.data() + static_cast<std::size_t>(line) * static_cast<std::size_t>(nx);
+        // The first brick: the least r ≤ 254 with a noisy brick within it, else 255 (the cap).
+        int c = 255;
+        if (noisyWithin(0, y, z, 254)) {
+          int lo = 0, hi = 254;
+          while (lo < hi) {
+            const int mid = (lo + hi) / 2;
+            if (noisyWithin(0, y, z, mid))
+              hi = mid;
+            else
+              lo = mid + 1;
+          }
+          c = lo;
         }
-  };
-  pass(+1);
-  pass(-1);
+        row[0] = static_cast<std::uint8_t>(c);
+        for (int x = 1; x < nx; ++x) {
+          if (c > 0 && noisyWithin(x, y, z, c - 1))
+            c = c - 1;
+          else if (!noisyWithin(x, y, z, c))
+            c = std::min(c + 1, 255);
+          row[x] = static_cast<std::uint8_t>(c);
+        }
+      },
+      8);
 }
 
 void QuietMap::buildTable(const std::vector<std::uint8_t>& flag) {
-  buildClearance(flag);
   const std::size_t sx = static_cast<std::size_t>(bricks_.x) + 1, sy = static_cast<std::size_t>(bricks_.y) + 1;
   sat_.assign(sx * sy * (static_cast<std::size_t>(bricks_.z) + 1), 0);
   for (int k = 1; k <= bricks_.z; ++k)
@@ -182,6 +192,7 @@ void QuietMap::buildTable(const std::vector<std::uint8_t>& flag) {
         at(i, j, k) = f + at(i - 1, j, k) + at(i, j - 1, k) + at(i, j, k - 1) - at(i - 1, j - 1, k) - at(i - 1, j, k - 1) -
                       at(i, j - 1, k - 1) + at(i - 1, j - 1, k - 1);
       }
+  buildClearance();
 }
 
 bool QuietMap::quiet(const glm::dvec3& lo, const glm::dvec3& hi) const {

@@ -72,6 +72,9 @@ class QuietMap {
   // The summed-area table, (bricks + 1)³ entries, x fastest: entry (i, j, k) counts the noisy
   // bricks with indices below (i, j, k) (the GPU's copy: quiet_texture.h).
   const std::vector<std::uint32_t>& table() const { return sat_; }
+  // Per brick (x fastest), its chessboard distance in bricks to the nearest noisy brick: 0 for a
+  // noisy one, at most 255 (also where none is noisy).
+  const std::vector<std::uint8_t>& clearances() const { return clearance_; }
 
  private:
   GridSpec grid_;
@@ -86,7 +89,7 @@ class QuietMap {
   // Per brick (x fastest), the chessboard distance in bricks to the nearest noisy brick: 0 for a
   // noisy brick, at most 255 (also where none is noisy).
   std::vector<std::uint8_t> clearance_;
-  void buildClearance(const std::vector<std::uint8_t>& brick_flags);
+  void buildClearance();  // from the summed-area table
   // The brick size for the grid (1 voxel up to `per_voxel_up_to` voxels an axis, then 2 up to 512,
   // then 4), and the summed-area table over per-brick flags.
   void chooseBricks(int per_voxel_up_to);

@@ -227,6 +227,37 @@ TEST(QuietMap, FlaggedVoxelsMakeTheBoxesWhoseSamplesTouchThemNoisy) {
   EXPECT_TRUE(absorbers.quiet(glm::dvec3(0.42), glm::dvec3(0.5)));  // a corner of the grid, clear of it
 }
 
+// Each brick's clearance is its chessboard distance to the nearest flagged brick (capped at 255),
+// as a brute-force search over every flagged brick finds it: a few scattered flags, a grid with a
+// single one in a corner (distances across the whole grid), and none at all.
+TEST(QuietMap, ClearanceIsTheChessboardDistanceToTheNearestNoisyBrick) {
+  for (const int case_index : {0, 1, 2}) {
+    const int n = 23;
+    const GridSpec grid = cubicGrid(n, 0.5);
+    std::vector<std::uint8_t> flags(grid.count(), 0);
+    std::vector<glm::ivec3> flagged;
+    std::mt19937 rng(11);
+    std::uniform_int_distribution<int> voxel(0, n - 1);
+    if (case_index == 0)
+      for (int i = 0; i < 12; ++i) flagged.emplace_back(voxel(rng), voxel(rng), voxel(rng));
+    if (case_index == 1) flagged.emplace_back(n - 1, 0, n - 2);
+    for (const glm::ivec3& v : flagged) flags[grid.index(v.x, v.y, v.z)] = 1;
+    const QuietMap map(grid, flags);
+    ASSERT_EQ(map.brickVoxels(), 1);
+    const std::vector<std::uint8_t>& clearance = map.clearances();
+    ASSERT_EQ(clearance.size(), grid.count());
+    for (int z = 0; z < n; ++z)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+          int expected = 255;
+          for (const glm::ivec3& v : flagged)
+            expected = std::min(expected, std::max({std::abs(x - v.x), std::abs(y - v.y), std::abs(z - v.z)}));
+          ASSERT_EQ(static_cast<int>(clearance[grid.index(x, y, z)]), expected)
+              << "case " << case_index << " at " << x << "," << y << "," << z;
+        }
+  }
+}
+
 // The answer from a brick's clearance (one lookup) is the summed-area table's (eight): random
 // boxes from a voxel to most of the grid, around scattered flagged voxels, against a brute-force
 // scan of the voxels every sample in the box takes as taps. At 200 voxels an axis the bricks are
