@@ -1,6 +1,6 @@
-// Minimal deterministic data parallelism over an index range (std::thread, no global pool).
-// Work is split into contiguous chunks, so results written per index are the same whatever the
-// thread count.
+// Minimal deterministic data parallelism over an index range (std::thread; the worker threads are
+// kept between calls, core/parallel.cpp). Work is split into contiguous chunks, so results written
+// per index are the same whatever the thread count.
 #pragma once
 
 #include <algorithm>
