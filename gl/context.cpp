@@ -107,7 +107,7 @@ GlBackend glBackendFromEnvironment(GlBackend fallback) {
 }
 
 DriverPreload::DriverPreload(const ContextOptions& options) {
-  const GlBackend requested = options.backend == GlBackend::Auto ? glBackendFromEnvironment() : options.backend;
+  const GlBackend requested = resolveGlBackend(options.backend);
   if (requested == GlBackend::OSMesa || requested == GlBackend::Auto) thread_ = std::thread(detail::loadOSMesaLibrary);
 }
 
@@ -118,7 +118,7 @@ DriverPreload::~DriverPreload() {
 GlContext::GlContext(const ContextOptions& options) {
   serial_ = g_nextSerial++;
   debug_ = options.debug.value_or(debugRequestedByEnvironment());
-  GlBackend requested = options.backend == GlBackend::Auto ? glBackendFromEnvironment() : options.backend;
+  GlBackend requested = resolveGlBackend(options.backend);
   switch (requested) {
     case GlBackend::OSMesa: backend_ = detail::createOSMesaBackend(options, debug_); break;
     case GlBackend::EGL: backend_ = detail::createEglBackend(options, debug_); break;

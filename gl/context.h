@@ -33,6 +33,11 @@ GlBackend parseGlBackend(std::string_view text, std::string_view source = "--gl"
 std::string_view glBackendName(GlBackend backend);
 // The back end EIKONAL_GL names, or `fallback` when it is unset or empty.
 GlBackend glBackendFromEnvironment(GlBackend fallback = GlBackend::Auto);
+// What a context asked for `requested` tries: EIKONAL_GL's back end for Auto (Auto again when it is
+// unset: OSMesa, then EGL), the back end itself otherwise.
+inline GlBackend resolveGlBackend(GlBackend requested) {
+  return requested == GlBackend::Auto ? glBackendFromEnvironment() : requested;
+}
 // Whether a window can be opened at all (DISPLAY or WAYLAND_DISPLAY is set): the viewer opens a
 // Window when this holds and nothing else was asked for, else renders headless.
 bool displayAvailable();

@@ -40,9 +40,7 @@ std::unique_ptr<Simulator> makeSimulator(const Volume& volume, const SimulatorBa
       // Two cases need no probe (a driver loaded for nothing costs 0.05-0.1 s a command): OSMesa
       // renders in software only (llvmpipe, softpipe), and a machine without a GPU device has
       // no hardware OpenGL whatever the back end.
-      const gl::GlBackend requested =
-          context.backend == gl::GlBackend::Auto ? gl::glBackendFromEnvironment() : context.backend;
-      if (requested == gl::GlBackend::OSMesa) {
+      if (gl::resolveGlBackend(context.backend) == gl::GlBackend::OSMesa) {
         if (options.report) options.report("OSMesa renders in software, so the CPU twin (faster than a software rasterizer)");
         return std::make_unique<CpuSimulator>(volume);
       }

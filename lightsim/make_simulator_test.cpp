@@ -69,14 +69,19 @@ TEST(MakeSimulatorTest, GlBackendWithAnUnknownOpenGlBackEndIsAnInputError) {
   EXPECT_NE(makeSimulator(volume, options).get(), nullptr);
 }
 
-TEST(MakeSimulatorTest, AutoTakesTheTwinOnASoftwareRasterizer) {
-  const Volume volume = smallSphere();
+// `--backend auto` with `--gl gl`: the simulator it makes and what it reports (one line each call).
+std::unique_ptr<Simulator> autoChoice(const Volume& volume, const std::string& gl, std::vector<std::string>& reports) {
   SimulatorBackendOptions options;
   options.backend = SimulatorBackend::Auto;
-  options.gl = "osmesa";  // llvmpipe (or softpipe): always software
-  std::vector<std::string> reports;
+  options.gl = gl;
   options.report = [&](const std::string& why) { reports.push_back(why); };
-  const std::unique_ptr<Simulator> simulator = makeSimulator(volume, options);
+  return makeSimulator(volume, options);
+}
+
+TEST(MakeSimulatorTest, AutoTakesTheTwinOnASoftwareRasterizer) {
+  std::vector<std::string> reports;
+  // llvmpipe (or softpipe): always software
+  const std::unique_ptr<Simulator> simulator = autoChoice(smallSphere(), "osmesa", reports);
   EXPECT_NE(dynamic_cast<CpuSimulator*>(simulator.get()), nullptr);
   ASSERT_EQ(reports.size(), 1u);
   EXPECT_EQ(reports[0], "OSMesa renders in software, so the CPU twin (faster than a software rasterizer)");
@@ -87,13 +92,8 @@ TEST(MakeSimulatorTest, AutoWithoutAGpuDeviceTakesTheTwinWithoutProbing) {
   // project's CI machines), the twin is chosen without a context: had the probe run, the report
   // would name the renderer it found ("llvmpipe ..., so the CPU twin ...").
   if (gl::gpuDevicePresent()) GTEST_SKIP() << "this machine has a GPU device: the probe runs";
-  const Volume volume = smallSphere();
-  SimulatorBackendOptions options;
-  options.backend = SimulatorBackend::Auto;
-  options.gl = "egl";
   std::vector<std::string> reports;
-  options.report = [&](const std::string& why) { reports.push_back(why); };
-  const std::unique_ptr<Simulator> simulator = makeSimulator(volume, options);
+  const std::unique_ptr<Simulator> simulator = autoChoice(smallSphere(), "egl", reports);
   EXPECT_NE(dynamic_cast<CpuSimulator*>(simulator.get()), nullptr);
   ASSERT_EQ(reports.size(), 1u);
   EXPECT_EQ(reports[0], "no GPU device (/dev/dri/renderD*, /dev/nvidia0), so the CPU twin");
@@ -101,18 +101,16 @@ TEST(MakeSimulatorTest, AutoWithoutAGpuDeviceTakesTheTwinWithoutProbing) {
 
 TEST(MakeSimulatorTest, AutoWithoutOpenGlTakesTheTwinAndSaysWhy) {
   const Volume volume = smallSphere();
-  SimulatorBackendOptions options;
-  options.backend = SimulatorBackend::Auto;
-  options.gl = "nonsense";
   std::vector<std::string> reports;
-  options.report = [&](const std::string& why) { reports.push_back(why); };
-  const std::unique_ptr<Simulator> simulator = makeSimulator(volume, options);
+  const std::unique_ptr<Simulator> simulator = autoChoice(volume, "nonsense", reports);
   EXPECT_NE(dynamic_cast<CpuSimulator*>(simulator.get()), nullptr);
   ASSERT_EQ(reports.size(), 1u);
   EXPECT_EQ(reports[0].rfind("no OpenGL context (--gl: unknown OpenGL back end 'nonsense'", 0), 0u) << reports[0];
   EXPECT_CONTAINS(reports[0], "), so the CPU twin");
-  options.report = nullptr;  // quiet
-  EXPECT_NE(makeSimulator(volume, options).get(), nullptr);
+  SimulatorBackendOptions quiet;  // no report
+  quiet.backend = SimulatorBackend::Auto;
+  quiet.gl = "nonsense";
+  EXPECT_NE(makeSimulator(volume, quiet).get(), nullptr);
 }
 
 TEST(MakeSimulatorTest, GpuSimulatorRunsInTheContextItIsGiven) {
