@@ -100,8 +100,7 @@ PatchSamples samplePatch(const Patch& patch, const VolumeSampler& sampler) {
 }
 
 bool straightSteps(const VolumeSampler& sampler, const SimulationOptions& options) {
-  if (!sampler.sharp() || options.volume_deposits ||
-      !(options.straight_step_voxels > options.step_voxels))
+  if (!sampler.sharp() || !(options.straight_step_voxels > options.step_voxels))
     return false;
   for (const InterfaceSlot& slot : sampler.interfaces().slots)
     if (slot.graded) return false;
@@ -114,6 +113,7 @@ StepContext makeStepContext(const VolumeSampler& sampler, const SimulationOption
   ctx.options = &options;
   ctx.dt = timeStep(sampler.grid(), options);
   ctx.step_dt = straightSteps(sampler, options) ? options.straight_step_voxels * voxelEdge(sampler.grid()) : ctx.dt;
+  ctx.retake_at_interfaces = ctx.step_dt > ctx.dt && options.volume_deposits;
   // A path of time t has length t/n (|dx/dt| = 1/n): at most this far from where it starts.
   ctx.straight_reach = ctx.step_dt / std::min(1.0, sampler.minIor());
   ctx.flux_ref = flux_ref;
@@ -310,8 +310,8 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
   // Free flight: one straight step of this time across quiet space (0: a step of Δt).
   const double flight = ctx.quiet && track ? freeFlightTime(patch, samples, ctx, threshold) : 0.0;
   // Δs_m = Δt/n(m) (Eq. 4.11); a sharp volume's ordinary step may be a straight step.
-  const double step_dt = flight > 0.0 ? flight : sharp ? sharpStepTime(patch, ctx) : ctx.dt;
-  const double ds = step_dt / n_m_old;
+  double step_dt = flight > 0.0 ? flight : sharp ? sharpStepTime(patch, ctx) : ctx.dt;
+  double ds = step_dt / n_m_old;
 
   // 1. Update (§6.2.2, Eq. 6.1/6.2 or RK2/RK4), then |w| = n(x_new); with sharp interfaces, Snell
   //    and Fresnel where a corner crosses one.
@@ -327,6 +327,15 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
   } else if (sharp) {
     const PatchSamples samples_before = samples;
     crossing = updateCornersSharp(patch, samples, ctx, step_dt);
+    if (crossing.met_interface && step_dt > ctx.dt && ctx.retake_at_interfaces) {
+      // A straight step's track is its chord, the ray itself only where no corner met an
+      // interface: one that did is retaken as a step of Δt (ALGORITHM.md "Straight steps").
+      patch = before;
+      samples = samples_before;
+      step_dt = ctx.dt;
+      ds = step_dt / n_m_old;
+      crossing = updateCornersSharp(patch, samples, ctx, step_dt);
+    }
     // A tear: undo the step and split the patch as it was, so that its parts cross on their own.
     // Either the step stretched it far, or it is the patch's first touch of an interface and some
     // corners will not follow (willTear).
@@ -453,7 +462,9 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
   if (track) {
     result.track = true;
     result.from = before.x;
-    result.track_flux = 0.5 * (before.flux + patch.flux);  // the flux along the step (trapezoid)
+    result.track_flux = 0.5 * (before.flux + patch.flux);  // the flux along the step, on average
+    result.track_start = before.flux;
+    result.track_end = patch.flux;
     result.lattice = subPathLattice(before, patch, result.track_flux, h, ctx.dim_irradiance);
     result.clip_to_receiver = reached;
   } else {
@@ -554,6 +565,9 @@ struct DepositSum {
   glm::dvec3 direction{0.0};
 };
 
+// The largest decay rate κ = ln(Φ_start/Φ_end) of a step's flux: e^(−50) leaves nothing that counts.
+constexpr double kMaxTrackDecay = 50.0;
+
 // The track deposits of one step (track_deposit.h), applied by slabs of z-slices in parallel: a
 // voxel belongs to one slab, whose thread adds the sub-paths in patch order, so the sums do not
 // depend on the thread count.
@@ -592,18 +606,34 @@ void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<Pat
     for (const std::uint32_t i : by_slab[static_cast<std::size_t>(slab64)]) {
       const PatchStepResult& r = results[i];
       const Patch& p = patches[i];
-      const glm::dvec3 flux = r.track_flux / static_cast<double>(r.lattice.x * r.lattice.y);
+      const double sub_paths = static_cast<double>(r.lattice.x * r.lattice.y);
+      // A flux that changes along the step (absorption, Fresnel) goes from start to end
+      // geometrically, Φ(t) = Φ_start·exp(−κ t) per channel with κ = ln(Φ_start/Φ_end): exact for
+      // absorption in one material, where a flight or a straight step may cross several voxels, and
+      // like the mean over a step of Δt otherwise. The path is then weighted at each Gauss node.
+      const bool decays = r.track_start != r.track_end;
+      const glm::dvec3 flux = (decays ? r.track_start : r.track_flux) / sub_paths;
       const double lum = luminance(flux);
+      glm::dvec3 kappa(0.0);
+      if (decays)
+        for (int c = 0; c < 3; ++c)
+          kappa[c] = r.track_start[c] > 0.0 && r.track_end[c] > 0.0
+                         ? std::clamp(std::log(r.track_start[c] / r.track_end[c]), -kMaxTrackDecay, kMaxTrackDecay)
+                         : (r.track_start[c] > 0.0 ? kMaxTrackDecay : 0.0);
       for (int iv = 0; iv < r.lattice.y; ++iv)
         for (int iu = 0; iu < r.lattice.x; ++iu) {
           const double u = (iu + 0.5) / r.lattice.x, v = (iv + 0.5) / r.lattice.y;
           const glm::dvec3 a = bilinear(r.from, u, v);
           glm::dvec3 b = bilinear(p.x, u, v);
+          double t_b = 1.0;  // the step's parameter at b (short of 1 where the receiver cuts it)
           if (r.clip_to_receiver && receiver) {
             const double ha = glm::dot(a - receiver->point, receiver->normal);
             const double hb = glm::dot(b - receiver->point, receiver->normal);
             if (ha <= 0.0) continue;  // this sub-path is already under the plane
-            if (hb < 0.0) b = a + (ha / (ha - hb)) * (b - a);
+            if (hb < 0.0) {
+              t_b = ha / (ha - hb);
+              b = a + t_b * (b - a);
+            }
           }
           const double length = glm::length(b - a);
           if (!(length > 0.0)) continue;
@@ -614,6 +644,7 @@ void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<Pat
           // (k0 − ½, k1 + ½) for slices k0..k1), the weights scaled by its share of the length:
           // a long flight across many slabs is integrated once, not once a slab.
           glm::dvec3 va = grid.toVoxel(a), vb = grid.toVoxel(b);
+          double t_a = 0.0;
           const double reach_lo = static_cast<double>(slab64 * slab_depth) - 0.5;
           const double reach_hi = static_cast<double>(std::min<std::int64_t>(grid.dims.z, (slab64 + 1) * slab_depth)) + 0.5;
           if (std::min(va.z, vb.z) < reach_lo || std::max(va.z, vb.z) > reach_hi) {
@@ -630,6 +661,33 @@ void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<Pat
             va = va + f0 * span;
             e *= f1 - f0;
             dsum *= f1 - f0;
+            const double t_span = t_b;
+            t_b = t_span * f1;
+            t_a = t_span * f0;
+          }
+          if (decays) {
+            // Per Gauss node n: the flux there, Φ·exp(−κ t_n), in both sums.
+            forEachTrackCell<true>(
+                va, vb, grid.dims,
+                [&](const TrackCell& c) {
+                  glm::dvec3 e_node[2], d_node[2];
+                  for (int n = 0; n < 2; ++n) {
+                    const glm::dvec3 f = glm::exp(-kappa * c.node_t[static_cast<std::size_t>(n)]);
+                    e_node[n] = e * f;
+                    d_node[n] = dsum * (lum > 0.0 ? luminance(flux * f) / lum : 0.0);
+                  }
+                  for (int k = 0; k < 8; ++k) {
+                    const int x = c.cell.x + (k & 1), y = c.cell.y + ((k >> 1) & 1), z = c.cell.z + ((k >> 2) & 1);
+                    if (x < 0 || y < 0 || z < z0 || x >= grid.dims.x || y >= grid.dims.y || z >= z1) continue;
+                    DepositSum& sum = sums[static_cast<std::size_t>(c.origin + corner_offset[k])];
+                    const double w0 = c.node_weight[0][static_cast<std::size_t>(k)];
+                    const double w1 = c.node_weight[1][static_cast<std::size_t>(k)];
+                    sum.irradiance += e_node[0] * w0 + e_node[1] * w1;
+                    sum.direction += d_node[0] * w0 + d_node[1] * w1;
+                  }
+                },
+                t_a, t_b);
+            continue;
           }
           forEachTrackCell(va, vb, grid.dims, [&](const TrackCell& c) {
             // The cell's two slices of voxels, each in this slab or not; within the grid

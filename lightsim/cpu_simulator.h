@@ -65,9 +65,12 @@ struct PatchStepResult {
   double max_key = 0.0;            // max: lum(E)
   // Track kernel (track_deposit.h): the sub-paths from the old corners to the new ones, each
   // carrying track_flux/(lattice.x·lattice.y), clipped at the receiver plane when the patch reached it.
+  // Along the step the flux goes from track_start to track_end, geometrically (exp(−σa s) in one
+  // material; applyTrackDeposits), track_flux being their mean, which sets the lattice.
   bool track = false;
   std::array<glm::dvec3, 4> from{};
   glm::dvec3 track_flux{0.0};
+  glm::dvec3 track_start{0.0}, track_end{0.0};
   glm::ivec2 lattice{1, 1};
   bool clip_to_receiver = false;
   glm::dvec3 absorbed{0.0};        // Φ·(1 − exp(−σa·Δs_m))
@@ -94,6 +97,9 @@ struct StepContext {
   // its reach, straight_reach world units around the corners, has σa = 0); none: Δt there.
   const QuietMap* absorbers = nullptr;
   double straight_reach = 0.0;
+  // …and with volume deposits, a straight step in which a corner met an interface is retaken as a
+  // step of Δt: a track deposit follows the step's chord, which is the ray only where none did.
+  bool retake_at_interfaces = false;
   double flux_ref = 0.0;     // Φ_ref
   // Track deposits: patch-steps under this irradiance take the dim light's sub-path lattice
   // (track_deposit.h trackSpacing; kDimTrackFraction of brightestIrradiance). 0: none does.
@@ -108,9 +114,9 @@ struct StepContext {
 };
 
 // Whether straight steps apply to a run (SimulationOptions::straight_step_voxels): a sharp volume
-// whose materials all have a constant n (none graded), no volume deposits (a track deposit's
-// sub-path is the chord of the step, not the kinked ray), and the option above Δt. With absorption,
-// only steps whose reach has σa = 0 (StepContext::absorbers).
+// whose materials all have a constant n (none graded) and the option above Δt. With absorption,
+// only steps whose reach has σa = 0 (StepContext::absorbers); with volume deposits, only steps in
+// which no corner meets an interface (StepContext::retake_at_interfaces).
 bool straightSteps(const VolumeSampler& sampler, const SimulationOptions& options);
 
 // The constants of a run: Δt, the voxel volume, the propagation box (no receiver).

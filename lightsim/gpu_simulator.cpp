@@ -356,6 +356,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     const StepContext twin = makeStepContext(sampler, options, fluxRef);
     step.stepDt = static_cast<float>(twin.step_dt);
     step.straightReach = static_cast<float>(twin.straight_reach);
+    step.retakeAtInterfaces = twin.retake_at_interfaces;
   }
   if (options.receiver) {
     step.receiverPoint = glm::vec3(receiver.point - origin);
@@ -380,7 +381,8 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     trackUniforms.receiverPoint = step.receiverPoint;
     trackUniforms.receiverNormal = step.receiverNormal;
     trackUniforms.dimIrradiance = static_cast<float>(kDimTrackFraction * brightestIrradiance(light, grid));
-    const double extent = 2.0 * kMaxUnsplitEdge * options.split_voxels + options.step_voxels;
+    const double step_voxels = std::max(options.step_voxels, static_cast<double>(step.stepDt) / voxelEdge(grid));
+    const double extent = 2.0 * kMaxUnsplitEdge * options.split_voxels + step_voxels;
     trackUniforms.maxExtentVoxels =
         std::min(trackPassFor().maxExtentVoxels(), static_cast<int>(std::ceil(1.5 * extent)) + 2);
     if (options.volume_deposits) step.flightExtentVoxels = static_cast<float>(trackUniforms.maxExtentVoxels);

@@ -61,6 +61,12 @@ struct TrackCell {
   glm::ivec3 cell{0};
   std::array<double, 8> weight{};
   bool interior = false;
+  // With the nodes (forEachTrackCell<true>): the parameters of the piece's two Gauss nodes along
+  // the segment given to forEachTrackCell, or along the range it was given (t_a at a, t_b at b), and
+  // each node's share of the weights (node_weight[0][k] + node_weight[1][k] = weight[k]), so that a
+  // caller can weight the path by a function of the parameter (a flux that decays along the step).
+  std::array<double, 2> node_t{};
+  std::array<std::array<double, 8>, 2> node_weight{};
 };
 
 namespace detail {
@@ -68,9 +74,9 @@ namespace detail {
 // `scale`: a walk through the cells of the voxel-centre lattice (cells between planes through voxel
 // centres, where the hats have their kinks), one piece per cell, each integrated with 2-point
 // Gauss–Legendre (exact: the weights are cubic in the arc length there).
-template <typename VisitCell>
+template <bool kNodes, typename VisitCell>
 void trackCellsShort(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec3& dims, double scale,
-                     VisitCell&& visit_cell) {
+                     VisitCell&& visit_cell, double t_a = 0.0, double t_b = 1.0) {
   const glm::dvec3 c0 = a - 0.5;  // lattice coordinates: cell k spans [k, k + 1)
   const glm::dvec3 delta = b - a;
   glm::ivec3 cell, step;
@@ -114,6 +120,14 @@ void trackCellsShort(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec3&
         const double wp = pxy[k & 3] * ((k & 4) ? p.z : 1.0 - p.z);
         const double wq = qxy[k & 3] * ((k & 4) ? q.z : 1.0 - q.z);
         out.weight[static_cast<std::size_t>(k)] = piece * (wp + wq);
+        if constexpr (kNodes) {
+          out.node_weight[0][static_cast<std::size_t>(k)] = piece * wp;
+          out.node_weight[1][static_cast<std::size_t>(k)] = piece * wq;
+        }
+      }
+      if constexpr (kNodes) {
+        out.node_t[0] = t_a + (t_b - t_a) * (t0 + (0.5 - kGauss) * length);
+        out.node_t[1] = t_a + (t_b - t_a) * (t0 + (0.5 + kGauss) * length);
       }
       out.cell = cell;
       out.origin = cell.x * sx + cell.y * sy + cell.z * sz;
@@ -134,9 +148,11 @@ void trackCellsShort(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec3&
 // exactly, and all weights sum to 1 over the voxels in the grid (those outside it must be skipped:
 // TrackCell::interior says whether any is). A cell may be visited more than once. Only the part
 // within the hats' reach is integrated, and a long one (a free flight) in equal pieces of at most 48
-// voxels of Σ|b − a| each (exact too: each piece is integrated exactly).
-template <typename VisitCell>
-void forEachTrackCell(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec3& dims, VisitCell&& visit_cell) {
+// voxels of Σ|b − a| each (exact too: each piece is integrated exactly). kNodes: also the Gauss
+// nodes (TrackCell::node_t, node_weight), their parameters running from t_a at a to t_b at b.
+template <bool kNodes = false, typename VisitCell>
+void forEachTrackCell(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec3& dims, VisitCell&& visit_cell,
+                      double t_a = 0.0, double t_b = 1.0) {
   // The part of the segment within the hats' reach, (−½, dims + ½) along every axis: the rest
   // visits nothing. A segment that leaves it (a flight out of the grid) is cut, its weights scaled
   // by the share of the length kept.
@@ -157,14 +173,17 @@ void forEachTrackCell(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec3
   const glm::dvec3 span = to - from;
   const double l1 = std::fabs(span.x) + std::fabs(span.y) + std::fabs(span.z);
   constexpr double kPiece = 48.0;
+  const double t_from = t_a + (t_b - t_a) * f0, t_to = t_a + (t_b - t_a) * f1;
   if (!(l1 > kPiece)) {
-    detail::trackCellsShort(from, to, dims, kept, visit_cell);
+    detail::trackCellsShort<kNodes>(from, to, dims, kept, visit_cell, t_from, t_to);
     return;
   }
   const int pieces = static_cast<int>(std::ceil(l1 / kPiece));
-  for (int i = 0; i < pieces; ++i)
-    detail::trackCellsShort(from + (static_cast<double>(i) / pieces) * span,
-                            from + (static_cast<double>(i + 1) / pieces) * span, dims, kept / pieces, visit_cell);
+  for (int i = 0; i < pieces; ++i) {
+    const double s0 = static_cast<double>(i) / pieces, s1 = static_cast<double>(i + 1) / pieces;
+    detail::trackCellsShort<kNodes>(from + s0 * span, from + s1 * span, dims, kept / pieces, visit_cell,
+                                    t_from + (t_to - t_from) * s0, t_from + (t_to - t_from) * s1);
+  }
 }
 
 // The same weights voxel by voxel: visit(voxel_index, weight) for each non-zero weight of a voxel

@@ -60,6 +60,7 @@ void UpdatePass::run(const PatchTextures& in, PatchTextures& out, const LiveCoun
   program_.set("uSplitLength", step.splitLength);  // sharp interfaces: tears
   program_.set("uMaxDepth", step.maxDepth);
   program_.set("uAxisSplit", step.axisSplit);
+  program_.set("uRetakeAtInterfaces", step.retakeAtInterfaces);
   triangle_.draw();
   gl::checkErrors("UpdatePass");
 }

@@ -351,10 +351,6 @@ bool rayHitsBox(const glm::dvec3& origin, const glm::dvec3& dir, const glm::dvec
   return true;
 }
 
-glm::dvec3 bilinear(const std::array<glm::dvec3, 4>& c, double u, double v) {
-  return ((1.0 - u) * (1.0 - v)) * c[0] + (u * (1.0 - v)) * c[1] + (u * v) * c[2] + ((1.0 - u) * v) * c[3];
-}
-
 SplitAxes splitAxes(const Patch& p, double threshold, SplitRule rule) {
   if (rule == SplitRule::Quad) {
     const bool split = p.longestEdge() > threshold;

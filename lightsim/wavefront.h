@@ -183,7 +183,9 @@ bool insideBox(const glm::dvec3& p, const glm::dvec3& lo, const glm::dvec3& hi);
 bool rayHitsBox(const glm::dvec3& origin, const glm::dvec3& dir, const glm::dvec3& lo, const glm::dvec3& hi);
 
 // The bilinear patch through corners x₀ = (0,0), x₁ = (1,0), x₂ = (1,1), x₃ = (0,1) at (u, v).
-glm::dvec3 bilinear(const std::array<glm::dvec3, 4>& c, double u, double v);
+inline glm::dvec3 bilinear(const std::array<glm::dvec3, 4>& c, double u, double v) {
+  return ((1.0 - u) * (1.0 - v)) * c[0] + (u * (1.0 - v)) * c[1] + (u * v) * c[2] + ((1.0 - u) * v) * c[3];
+}
 
 // Parameter origin (u_j, v_j) of child j of a 2×2 split: (0,0), (½,0), (0,½), (½,½) (step 6; the
 // histogram pyramid's child order 0: (0,0), 1: (1,0), 2: (0,1), 3: (1,1)).

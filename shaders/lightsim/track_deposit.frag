@@ -16,6 +16,7 @@ uniform float uInvVoxelVolume;  // 1 / V_voxel
 flat in vec4 vBefore[4];  // corners: (continuous voxel coordinates, height above the receiver)
 flat in vec4 vAfter[4];
 flat in vec4 vFlux;   // (Φ_sub, clip at the receiver 1/0)
+flat in vec4 vDecay;  // (κ, decays 1/0): Φ(t) = Φ_sub·exp(−κ t) along the step (track_deposit.vert)
 flat in ivec4 vBox;   // (i_min, j_min, i_max, j_max) of this slice, inclusive
 flat in ivec4 vTile;  // (tile origin x, y, slice k, n_u + 32·n_v)
 
@@ -33,13 +34,21 @@ float hat(vec3 p, vec3 c) {
   return t.x * t.y * t.z;
 }
 
+// A decaying flux (vDecay.w): the step's parameter at t = 1 of the sub-path being integrated (short
+// of 1 where the receiver cuts it), so that a node at t lies at gStepAt1·t of the step.
+float gStepAt1 = 1.0;
+
 // ∫ K_c over the parameter interval [s0, s1] of p(t) = pa + t·dv, where K_c is a cubic polynomial
 // of t (no kink inside): 2-point Gauss–Legendre, exact for cubics, with the nodes of track_deposit.h.
-float hatPiece(vec3 pa, vec3 dv, vec3 c, float s0, float s1) {
+// Per channel, each node weighted by the flux's decay there, exp(−κ·gStepAt1·t) (1 without decay).
+vec3 hatPiece(vec3 pa, vec3 dv, vec3 c, float s0, float s1) {
   float len = s1 - s0;
-  if (!(len > 0.0)) return 0.0;
+  if (!(len > 0.0)) return vec3(0.0);
   const float kGauss = 0.28867513459481288;  // 1/(2√3): the nodes at ½ ± this
-  return 0.5 * len * (hat(pa + (s0 + (0.5 - kGauss) * len) * dv, c) + hat(pa + (s0 + (0.5 + kGauss) * len) * dv, c));
+  float sp = s0 + (0.5 - kGauss) * len, sq = s0 + (0.5 + kGauss) * len;
+  float hp = hat(pa + sp * dv, c), hq = hat(pa + sq * dv, c);
+  if (vDecay.w < 0.5) return vec3(0.5 * len * (hp + hq));
+  return 0.5 * len * (hp * exp(-vDecay.xyz * (gStepAt1 * sp)) + hq * exp(-vDecay.xyz * (gStepAt1 * sq)));
 }
 
 // forEachTrackWeight's weight for the one voxel centred at c: ∫₀¹ K_c(pa + t·dv) dt. K_c is non-zero
@@ -47,13 +56,13 @@ float hatPiece(vec3 pa, vec3 dv, vec3 c, float s0, float s1) {
 // is linear but for one kink where p = c on that axis. Cut at those ≤ 3 kinks, every piece is a
 // cubic, integrated exactly. (The CPU cuts at every plane through voxel centres, which holds these
 // cuts; between them both integrate the same polynomial.)
-float trackWeight(vec3 pa, vec3 dv, vec3 c) {
+vec3 trackWeight(vec3 pa, vec3 dv, vec3 c) {
   float t0 = 0.0, t1 = 1.0;
   vec3 kink = vec3(1.0);
   for (int axis = 0; axis < 3; ++axis) {
     float r = c[axis] - pa[axis];
     if (dv[axis] == 0.0) {
-      if (!(abs(r) < 1.0)) return 0.0;  // the whole path is off this hat's support
+      if (!(abs(r) < 1.0)) return vec3(0.0);  // the whole path is off this hat's support
       continue;
     }
     float inv = 1.0 / dv[axis];
@@ -62,7 +71,7 @@ float trackWeight(vec3 pa, vec3 dv, vec3 c) {
     t1 = min(t1, max(ta, tb));
     kink[axis] = r * inv;
   }
-  if (!(t1 > t0)) return 0.0;
+  if (!(t1 > t0)) return vec3(0.0);
   kink = clamp(kink, t0, t1);
   // Sort the three kinks (a 3-element network).
   float k0 = min(kink.x, kink.y), k1 = max(kink.x, kink.y), k2 = kink.z;
@@ -82,8 +91,8 @@ void main() {
   vec3 voxelSize = (uBoundsMax - uBoundsMin) / vec3(uDims);
   int nu = vTile.w % 32, nv = vTile.w / 32;
   bool clip = vFlux.w > 0.5;
-  float sumLength = 0.0;          // Σ L·w_v over the sub-paths
-  vec3 sumDirection = vec3(0.0);  // Σ (b − a)·w_v (world)
+  vec3 sumLength = vec3(0.0);     // Σ L·w_v over the sub-paths (per channel: w_v holds the decay)
+  vec3 sumDirection = vec3(0.0);  // Σ (b − a)·w_v (world), w_v by luminance with a decay
   for (int iv = 0; iv < nv; ++iv) {
     float v = (float(iv) + 0.5) / float(nv);
     for (int iu = 0; iu < nu; ++iu) {
@@ -91,22 +100,26 @@ void main() {
       vec4 a = bilinearPoint(vBefore[0], vBefore[1], vBefore[2], vBefore[3], u, v);
       vec4 b = bilinearPoint(vAfter[0], vAfter[1], vAfter[2], vAfter[3], u, v);
       vec3 pa = a.xyz, pb = b.xyz;
+      gStepAt1 = 1.0;
       if (clip) {
         // The receiver: a sub-path already on or under the plane deposits nothing, one that crosses
         // it stops there (applyTrackDeposits; a.w, b.w are the heights of its ends).
         if (a.w <= 0.0) continue;
-        if (b.w < 0.0) pb = pa + (a.w / (a.w - b.w)) * (pb - pa);
+        if (b.w < 0.0) {
+          gStepAt1 = a.w / (a.w - b.w);
+          pb = pa + gStepAt1 * (pb - pa);
+        }
       }
       vec3 dv = pb - pa;
       vec3 d = dv * voxelSize;  // b − a in the world
       float len = length(d);
       if (!(len > 0.0)) continue;
-      float w = trackWeight(pa, dv, c);
+      vec3 w = trackWeight(pa, dv, c);
       sumLength += len * w;
-      sumDirection += d * w;
+      sumDirection += d * (vDecay.w < 0.5 ? w.x : lum(vFlux.rgb * w));
     }
   }
-  if (!(sumLength > 0.0)) discard;  // this voxel's hat missed every sub-path
+  if (!(max(sumLength.x, max(sumLength.y, sumLength.z)) > 0.0)) discard;  // this voxel's hat missed every sub-path
   oEnergy = vec4(vFlux.rgb * (sumLength * uInvVoxelVolume), 0.0);
-  oDirection = vec4(lum(vFlux.rgb) * sumDirection, 1.0);
+  oDirection = vec4((vDecay.w < 0.5 ? lum(vFlux.rgb) : 1.0) * sumDirection, 1.0);
 }

@@ -31,6 +31,9 @@ uniform vec3 uReceiverNormal;  // unit, pointing to the side the light comes fro
 flat out vec4 vBefore[4];
 flat out vec4 vAfter[4];
 flat out vec4 vFlux;       // (Φ_sub = track_flux/(n_u·n_v), clip at the receiver: 1, else 0)
+// A flux that changes along the step goes from Φ_start to Φ_end geometrically (applyTrackDeposits):
+// Φ_sub is then Φ_start/(n_u·n_v) and (κ, 1) = (ln(Φ_start/Φ_end) per channel, 1); else (0, 0).
+flat out vec4 vDecay;
 flat out ivec4 vBox;       // the voxel box in this slice: (i_min, j_min, i_max, j_max), inclusive
 flat out ivec4 vTile;      // (tile origin x, y in the atlas, slice k, n_u + 32·n_v)
 
@@ -130,7 +133,17 @@ void main() {
   vBefore[2] = voxelCorner(a2, c[2]); vBefore[3] = voxelCorner(a3, c[3]);
   vAfter[0] = voxelCorner(b0, c[4]); vAfter[1] = voxelCorner(b1, c[5]);
   vAfter[2] = voxelCorner(b2, c[6]); vAfter[3] = voxelCorner(b3, c[7]);
+  vec3 fluxStart = texelFetch(uBefore[6], texel, 0).rgb, fluxEnd = texelFetch(uAfter[6], texel, 0).rgb;
   vFlux = vec4(info.rgb / float(nu * nv), info.a >= 1.0 && uClipEnabled ? 1.0 : 0.0);
+  vDecay = vec4(0.0);
+  if (fluxStart != fluxEnd) {
+    const float kMaxDecay = 50.0;  // cpu_simulator.cpp kMaxTrackDecay
+    for (int ch = 0; ch < 3; ++ch)
+      vDecay[ch] = fluxStart[ch] > 0.0 && fluxEnd[ch] > 0.0 ? clamp(log(fluxStart[ch] / fluxEnd[ch]), -kMaxDecay, kMaxDecay)
+                                                           : (fluxStart[ch] > 0.0 ? kMaxDecay : 0.0);
+    vDecay.w = 1.0;
+    vFlux.rgb = fluxStart / float(nu * nv);
+  }
   vBox = ivec4(vmin.xy, vmax.xy);
   ivec2 origin = ivec2((k % ATLAS_TILES_X) * ATLAS_DIMS.x, (k / ATLAS_TILES_X) * ATLAS_DIMS.y);
   vTile = ivec4(origin, k, nu + 32 * nv);

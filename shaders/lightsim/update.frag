@@ -34,6 +34,7 @@ uniform float uMaxDepth;       // max_depth
 #ifdef SHARP_INTERFACES
 #include "lightsim/sharp.glsl"
 uniform bool uAxisSplit;     // SplitRule::Axis
+uniform bool uRetakeAtInterfaces;  // StepUniforms::retakeAtInterfaces
 const float kTearFactor = 2.0;  // cpu_simulator.cpp
 #endif
 #include "lightsim/flight.glsl"
@@ -144,15 +145,25 @@ void main() {
     }
   } else {
     stepTime = sharpStepTime(p);
-    for (int c = 0; c < 4; ++c) {
-      CornerCrossings cc = advanceCornerSharp(p.x[c], p.w[c], p.medium[c], stepTime);
-      if (cc.transmitted > 0 || cc.reflected > 0 || cc.blocked) metMask |= 1 << c;
-      reflections += cc.reflected;
-      if (cc.reflected > 0) reflectedMask |= 1 << c;
-      blocked += cc.blocked ? 1 : 0;
-      if (cc.transmitted > 0) transmittedMask |= 1 << c;
-      transmittance *= pow(cc.transmittance, 0.25);
-      opticalDepth += 0.25 * cc.opticalDepth;
+    // With volume deposits a straight step in which a corner met an interface is retaken as a step
+    // of Δt: its track deposit follows the chord, the ray only where no corner met one.
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      for (int c = 0; c < 4; ++c) {
+        CornerCrossings cc = advanceCornerSharp(p.x[c], p.w[c], p.medium[c], stepTime);
+        if (cc.transmitted > 0 || cc.reflected > 0 || cc.blocked) metMask |= 1 << c;
+        reflections += cc.reflected;
+        if (cc.reflected > 0) reflectedMask |= 1 << c;
+        blocked += cc.blocked ? 1 : 0;
+        if (cc.transmitted > 0) transmittedMask |= 1 << c;
+        transmittance *= pow(cc.transmittance, 0.25);
+        opticalDepth += 0.25 * cc.opticalDepth;
+      }
+      if (!uRetakeAtInterfaces || metMask == 0 || !(stepTime > uDt)) break;
+      p = before;
+      stepTime = uDt;
+      transmittance = 1.0;
+      opticalDepth = vec3(0.0);
+      metMask = transmittedMask = reflectedMask = blocked = reflections = 0;
     }
   }
   p.reflections += reflections;
