@@ -568,6 +568,18 @@ struct DepositSum {
 // The largest decay rate κ = ln(Φ_start/Φ_end) of a step's flux: e^(−50) leaves nothing that counts.
 constexpr double kMaxTrackDecay = 50.0;
 
+// exp(−x) per channel. A step's decay is mostly small (x ≤ ¼: a few voxels of absorption, a
+// Fresnel loss), where the Taylor series to x⁵ is within 3.4·10⁻⁷ (x⁶/720) at a sixth of the cost.
+glm::dvec3 decayFactor(const glm::dvec3& x) {
+  glm::dvec3 f;
+  for (int c = 0; c < 3; ++c) {
+    const double v = x[c];
+    f[c] = std::fabs(v) <= 0.25 ? 1.0 - v * (1.0 - v * (0.5 - v * (1.0 / 6.0 - v * (1.0 / 24.0 - v * (1.0 / 120.0)))))
+                                : std::exp(-v);
+  }
+  return f;
+}
+
 // The track deposits of one step (track_deposit.h), applied by slabs of z-slices in parallel: a
 // voxel belongs to one slab, whose thread adds the sub-paths in patch order, so the sums do not
 // depend on the thread count.
@@ -672,13 +684,16 @@ void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<Pat
                 [&](const TrackCell& c) {
                   glm::dvec3 e_node[2], d_node[2];
                   for (int n = 0; n < 2; ++n) {
-                    const glm::dvec3 f = glm::exp(-kappa * c.node_t[static_cast<std::size_t>(n)]);
+                    const glm::dvec3 f = decayFactor(kappa * c.node_t[static_cast<std::size_t>(n)]);
                     e_node[n] = e * f;
                     d_node[n] = dsum * (lum > 0.0 ? luminance(flux * f) / lum : 0.0);
                   }
+                  const bool whole = c.interior && c.cell.z >= z0 && c.cell.z + 1 < z1;
                   for (int k = 0; k < 8; ++k) {
-                    const int x = c.cell.x + (k & 1), y = c.cell.y + ((k >> 1) & 1), z = c.cell.z + ((k >> 2) & 1);
-                    if (x < 0 || y < 0 || z < z0 || x >= grid.dims.x || y >= grid.dims.y || z >= z1) continue;
+                    if (!whole) {
+                      const int x = c.cell.x + (k & 1), y = c.cell.y + ((k >> 1) & 1), z = c.cell.z + ((k >> 2) & 1);
+                      if (x < 0 || y < 0 || z < z0 || x >= grid.dims.x || y >= grid.dims.y || z >= z1) continue;
+                    }
                     DepositSum& sum = sums[static_cast<std::size_t>(c.origin + corner_offset[k])];
                     const double w0 = c.node_weight[0][static_cast<std::size_t>(k)];
                     const double w1 = c.node_weight[1][static_cast<std::size_t>(k)];
