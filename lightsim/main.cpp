@@ -80,8 +80,8 @@ int run(int argc, char** argv) {
   options.straight_step_voxels = 2.0;
   app.add_option("--straight-step", options.straight_step_voxels,
                  "VOXELS: the step where every ray is straight between sharp interfaces and crosses "
-                 "them exactly (materials of constant n, no volume deposits, nothing absorbing within reach; "
-                 "default 2, 0: off, steps of --step)")
+                 "them exactly (materials of constant n, nothing absorbing within reach; with volume deposits "
+                 "only where no corner meets an interface; default 2, 0: off, steps of --step)")
       ->check(CLI::Range(0.0, 64.0));
   std::string volume_deposits = "auto";
   app.add_option("--volume-deposits", volume_deposits,

@@ -137,12 +137,17 @@ void main() {
   vFlux = vec4(info.rgb / float(nu * nv), info.a >= 1.0 && uClipEnabled ? 1.0 : 0.0);
   vDecay = vec4(0.0);
   if (fluxStart != fluxEnd) {
-    const float kMaxDecay = 50.0;  // cpu_simulator.cpp kMaxTrackDecay
+    // cpu_simulator.cpp kMaxTrackDecay, kMeanTrackDecay: up to κ = 10⁻³ the mean is deposited.
+    const float kMaxDecay = 50.0, kMeanDecay = 1e-3;
     for (int ch = 0; ch < 3; ++ch)
       vDecay[ch] = fluxStart[ch] > 0.0 && fluxEnd[ch] > 0.0 ? clamp(log(fluxStart[ch] / fluxEnd[ch]), -kMaxDecay, kMaxDecay)
                                                            : (fluxStart[ch] > 0.0 ? kMaxDecay : 0.0);
-    vDecay.w = 1.0;
-    vFlux.rgb = fluxStart / float(nu * nv);
+    if (any(greaterThan(abs(vDecay.xyz), vec3(kMeanDecay)))) {
+      vDecay.w = 1.0;
+      vFlux.rgb = fluxStart / float(nu * nv);
+    } else {
+      vDecay = vec4(0.0);
+    }
   }
   vBox = ivec4(vmin.xy, vmax.xy);
   ivec2 origin = ivec2((k % ATLAS_TILES_X) * ATLAS_DIMS.x, (k / ATLAS_TILES_X) * ATLAS_DIMS.y);
