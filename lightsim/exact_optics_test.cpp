@@ -478,6 +478,29 @@ TEST(ExactOpticsSlab, ShiftsTheBeamBySnellsLawAndTransmitsTheFresnelFraction) {
   EXPECT_LT(r.stats.ledgerResidual(), 1e-9);
 }
 
+// The two slabs of the next tests in the unit box at `res`³: clear glass (n = 1.5) over an
+// absorbing liquid (n = 1.33, σa = 2 per material), both 0.2 thick and wider than the grid.
+Volume twoSlabs(int res) {
+  return sharpVolume(std::vector<std::string>{"procedural:box,size=4:0.2:4,center=0:0.2:0,ior=1.5",
+                                              "procedural:box,size=4:0.2:4,center=0:-0.2:0,ior=1.33,sigma_a=2:2:2"},
+                     res, box({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5}));
+}
+
+// Light tilted θi from the vertical towards +x, and a single pass (no reflected wavefront followed)
+// with free flight, with or without the volume's light.
+LightSpec tiltedLight(double theta_i) {
+  LightSpec light;
+  light.direction = glm::dvec3(std::sin(theta_i), -std::cos(theta_i), 0.0);
+  return light;
+}
+SimulationOptions singlePass(bool volume_deposits) {
+  SimulationOptions options;
+  options.bounces = 0;
+  options.free_flight = true;
+  options.volume_deposits = volume_deposits;
+  return options;
+}
+
 // Straight steps in an absorbing volume: a clear glass slab (n = 1.5) over an absorbing liquid one
 // (n = 1.33, σa = 2), both 0.2 thick, light tilted 20°, single pass. What reaches the floor is
 // cos θi (1 − R₁)² (1 − R₂)² exp(−σa d / cos θt₂), exactly. Two ways to absorb:
@@ -489,10 +512,7 @@ TEST(ExactOpticsSlab, ShiftsTheBeamBySnellsLawAndTransmitsTheFresnelFraction) {
 //    (the absorber map), straight only near the clear slab.
 TEST(ExactOpticsSlab, StraightStepsKeepBeerLambertInAnAbsorbingLiquid) {
   const double theta_i = 20.0 * std::numbers::pi / 180.0, sigma = 2.0, d = 0.2;
-  const Bounds b = box({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5});
-  const Volume per_material = sharpVolume(std::vector<std::string>{"procedural:box,size=4:0.2:4,center=0:0.2:0,ior=1.5",
-                                           "procedural:box,size=4:0.2:4,center=0:-0.2:0,ior=1.33,sigma_a=2:2:2"},
-                                          48, b);
+  const Volume per_material = twoSlabs(48);
   // A liquid voxel at the grid's −x −z corner: its light lands near x ≈ −0.3 on the floor, outside
   // the measured square; the slot's σa then disagrees with the field, which alone describes it.
   Volume field = per_material;
@@ -501,12 +521,8 @@ TEST(ExactOpticsSlab, StraightStepsKeepBeerLambertInAnAbsorbingLiquid) {
   field.fields.at("sigma_a").voxel(odd_voxel)[0] = 2.1f;
   ASSERT_TRUE(VolumeSampler(per_material).absorptionPerMaterial());
   ASSERT_FALSE(VolumeSampler(field).absorptionPerMaterial());
-  LightSpec light;
-  light.direction = glm::dvec3(std::sin(theta_i), -std::cos(theta_i), 0.0);
-  SimulationOptions options;
-  options.bounces = 0;  // single pass
-  options.free_flight = true;
-  options.volume_deposits = false;
+  const LightSpec light = tiltedLight(theta_i);
+  SimulationOptions options = singlePass(false);
   // The floor's square where every ray came in through the grid's top face (back along the light,
   // x shifts by about −0.4 from the floor to the top), so it crossed both slabs inside the grid
   // (the slabs reach beyond the grid's sides, where the light does not start).
@@ -563,9 +579,7 @@ TEST(ExactOpticsSlab, StraightStepsKeepBeerLambertInAnAbsorbingLiquid) {
   EXPECT_LT(straight_patch_steps[1][0], 0.6 * static_cast<double>(straight_patch_steps[0][0]));
   // A second resolution: per material the absorbing thickness is the interfaces', not the grid's, so
   // a 32³ grid (slabs 6.4 voxels thick) holds the same exact answer on both back ends.
-  const Volume coarse = sharpVolume(std::vector<std::string>{"procedural:box,size=4:0.2:4,center=0:0.2:0,ior=1.5",
-                                     "procedural:box,size=4:0.2:4,center=0:-0.2:0,ior=1.33,sigma_a=2:2:2"},
-                                    32, b);
+  const Volume coarse = twoSlabs(32);
   ASSERT_TRUE(VolumeSampler(coarse).absorptionPerMaterial());
   for (const Backend backend : {Backend::Cpu, Backend::Gl}) {
     const BakeResult r = simulatorFor(coarse, backend)->run(light, straight);
@@ -594,7 +608,6 @@ TEST(ExactOpticsSlab, StraightStepsKeepBeerLambertInAnAbsorbingLiquid) {
 TEST(ExactOpticsSlab, VolumeIrradianceFollowsTheBeamThroughBothSlabs) {
   const double theta_i = 35.0 * std::numbers::pi / 180.0, sigma = 2.0;
   const double interfaces[4] = {0.3, 0.1, -0.1, -0.3};  // glass top, bottom; liquid top, bottom
-  const Bounds b = box({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5});
   const double R1 = reference::fresnelReflectance(1.0, 1.5, std::cos(theta_i));
   const double R2 = reference::fresnelReflectance(1.0, 1.33, std::cos(theta_i));
   const double cos_i = std::cos(theta_i);
@@ -608,18 +621,12 @@ TEST(ExactOpticsSlab, VolumeIrradianceFollowsTheBeamThroughBothSlabs) {
     if (y > interfaces[3]) return gap * (1.0 - R2) * cos_i / cos_t2 * std::exp(-sigma * (interfaces[2] - y) / cos_t2);
     return gap * (1.0 - R2) * (1.0 - R2) * std::exp(-sigma * (interfaces[2] - interfaces[3]) / cos_t2);
   };
-  LightSpec light;
-  light.direction = glm::dvec3(std::sin(theta_i), -std::cos(theta_i), 0.0);
-  SimulationOptions options;
-  options.bounces = 0;  // single pass
-  options.free_flight = true;
-  options.volume_deposits = true;
+  const LightSpec light = tiltedLight(theta_i);
+  const SimulationOptions options = singlePass(true);
   SimulationOptions straight = options;
   straight.straight_step_voxels = 2.0;
   for (const int res : {48, 32}) {
-    const Volume volume = sharpVolume(std::vector<std::string>{"procedural:box,size=4:0.2:4,center=0:0.2:0,ior=1.5",
-                                       "procedural:box,size=4:0.2:4,center=0:-0.2:0,ior=1.33,sigma_a=2:2:2"},
-                                      res, b);
+    const Volume volume = twoSlabs(res);
     const GridSpec& g = volume.grid;
     const double h = g.voxelSize().y;
     // The hat's average by the midpoint rule on 4000 pieces of its support: exact to ~10⁻⁶ away
