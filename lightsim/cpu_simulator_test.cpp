@@ -32,22 +32,6 @@ constexpr double kPi = std::numbers::pi;
 // Relative residual of the energy ledger, worst channel.
 double ledgerResidual(const SimulationStats& s) { return s.ledgerResidual(); }
 
-// Sets EIKONAL_THREADS for the lifetime of the object and restores it afterwards.
-class ScopedThreads {
- public:
-  explicit ScopedThreads(int n) {
-    if (const char* old = std::getenv("EIKONAL_THREADS")) old_ = old;
-    ::setenv("EIKONAL_THREADS", std::to_string(n).c_str(), 1);
-  }
-  ~ScopedThreads() {
-    if (old_) ::setenv("EIKONAL_THREADS", old_->c_str(), 1);
-    else ::unsetenv("EIKONAL_THREADS");
-  }
-
- private:
-  std::optional<std::string> old_;
-};
-
 // The y index of the voxel layer that contains the world coordinate y.
 int layerOf(const GridSpec& g, double y) { return int(std::floor((y - g.bounds_min.y) / g.voxelSize().y)); }
 

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdlib>
 #include <optional>
 #include <string>
 #include <vector>
@@ -36,6 +37,23 @@
 #include "voxelize/procedural.h"
 
 namespace eik::test_scenes {
+
+// Sets EIKONAL_THREADS for the lifetime of the object and restores it afterwards.
+class ScopedThreads {
+ public:
+  explicit ScopedThreads(int n) {
+    if (const char* old = std::getenv("EIKONAL_THREADS")) old_ = old;
+    ::setenv("EIKONAL_THREADS", std::to_string(n).c_str(), 1);
+  }
+  ~ScopedThreads() {
+    if (old_) ::setenv("EIKONAL_THREADS", old_->c_str(), 1);
+    else ::unsetenv("EIKONAL_THREADS");
+  }
+
+ private:
+  std::optional<std::string> old_;
+};
+
 
 // One headless context for the whole test program (OSMesa, or EGL when EIKONAL_GL says so), made
 // current. It is never destroyed: GL objects of any test may outlive their test.

@@ -69,13 +69,21 @@ struct TrackCell {
   std::array<std::array<double, 8>, 2> node_weight{};
 };
 
+// The walk is always inlined into its caller, so that it is compiled with the caller's instruction
+// set: the CPU twin's deposits (track_deposit_cpu.cpp) compile their callers once per SIMD target.
+#if defined(__GNUC__)
+#define EIK_TRACK_INLINE inline __attribute__((always_inline))
+#else
+#define EIK_TRACK_INLINE inline
+#endif
+
 namespace detail {
 // forEachTrackCell on a segment of a few dozen voxels at most, every weight multiplied by
 // `scale`: a walk through the cells of the voxel-centre lattice (cells between planes through voxel
 // centres, where the hats have their kinks), one piece per cell, each integrated with 2-point
 // Gauss–Legendre (exact: the weights are cubic in the arc length there).
 template <bool kNodes, typename VisitCell>
-void trackCellsShort(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec3& dims, double scale,
+EIK_TRACK_INLINE void trackCellsShort(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec3& dims, double scale,
                      VisitCell&& visit_cell, double t_a = 0.0, double t_b = 1.0) {
   const glm::dvec3 c0 = a - 0.5;  // lattice coordinates: cell k spans [k, k + 1)
   const glm::dvec3 delta = b - a;
@@ -151,7 +159,7 @@ void trackCellsShort(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec3&
 // voxels of Σ|b − a| each (exact too: each piece is integrated exactly). kNodes: also the Gauss
 // nodes (TrackCell::node_t, node_weight), their parameters running from t_a at a to t_b at b.
 template <bool kNodes = false, typename VisitCell>
-void forEachTrackCell(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec3& dims, VisitCell&& visit_cell,
+EIK_TRACK_INLINE void forEachTrackCell(const glm::dvec3& a, const glm::dvec3& b, const glm::ivec3& dims, VisitCell&& visit_cell,
                       double t_a = 0.0, double t_b = 1.0) {
   // The part of the segment within the hats' reach, (−½, dims + ½) along every axis: the rest
   // visits nothing. A segment that leaves it (a flight out of the grid) is cut, its weights scaled

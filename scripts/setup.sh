@@ -8,6 +8,7 @@ packages=(
   build-essential cmake pkg-config git
   libosmesa6-dev libegl-dev libegl-mesa0 libgl1-mesa-dri
   libglfw3-dev libglm-dev libopenexr-dev libpng-dev libstb-dev libtinygltf-dev python3-glad
+  libhwy-dev  # Google Highway: SIMD in the CPU twin, dispatched at run time to the CPU's vectors
   libjemalloc-dev  # the programs' allocator (core/allocator.cpp): huge pages, fewer page faults
   openimageio-tools  # scripts: oiiotool converts the HDRIs (fetch_assets.sh) and the gallery's PNGs
   nlohmann-json3-dev libcli11-dev zlib1g-dev
