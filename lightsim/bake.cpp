@@ -85,6 +85,7 @@ nlohmann::json SimulationStats::toJson() const {
   for (const auto& [name, seconds] : phase_seconds) j["phase_seconds"][name] = seconds;
   j["backend"] = backend;
   j["renderer"] = renderer;
+  if (!simd.empty()) j["simd"] = simd;
   nlohmann::json warnings = nlohmann::json::array();
   if (initial_patches == 0) warnings.push_back("the light misses the volume: the bake is empty");
   if (flux_unfinished.x + flux_unfinished.y + flux_unfinished.z > 0.0)

@@ -565,6 +565,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   stats.backend = "cpu";
   const unsigned threads = workerThreads();
   stats.renderer = "cpu, " + std::to_string(threads) + (threads == 1 ? " thread" : " threads");
+  stats.simd = trackDepositTarget();
 
   Stopwatch phase;
   validateLight(light);

@@ -30,6 +30,9 @@ namespace fs = std::filesystem;
 namespace eik {
 namespace {
 
+// "cpu, 2 threads, SIMD AVX3" or the GL renderer's name.
+std::string rendererName(const SimulationStats& s) { return s.renderer + (s.simd.empty() ? "" : ", SIMD " + s.simd); }
+
 int run(int argc, char** argv) {
   std::string input, output, light_text, power_text = "1,1,1", scene_path, backend = "auto", deposit = "accumulate",
                                          integrator = "euler", split_rule = "axis", at_max_depth = "keep", stats_path,
@@ -232,7 +235,7 @@ int run(int argc, char** argv) {
                            {"grid", {volume.grid.dims.x, volume.grid.dims.y, volume.grid.dims.z}}};
     std::printf("lightsim bench: %dx%dx%d, %s: median %.3f s of %d runs (min %.3f, max %.3f); %llu patch-steps, "
                 "%.3g patch-steps/s; peak %llu patches",
-                volume.grid.dims.x, volume.grid.dims.y, volume.grid.dims.z, result.stats.renderer.c_str(), median,
+                volume.grid.dims.x, volume.grid.dims.y, volume.grid.dims.z, rendererName(result.stats).c_str(), median,
                 bench_runs, sorted.front(), sorted.back(), static_cast<unsigned long long>(result.stats.total_patches),
                 rate, static_cast<unsigned long long>(result.stats.peak_patches));
     if (stats_json.contains("texture_bytes"))
@@ -260,7 +263,7 @@ int run(int argc, char** argv) {
     const SimulationStats& s = result.stats;
     std::fprintf(stderr, "lightsim: %d steps, %llu initial / %llu peak patches, %llu splits on %s\n", s.steps,
                  static_cast<unsigned long long>(s.initial_patches), static_cast<unsigned long long>(s.peak_patches),
-                 static_cast<unsigned long long>(s.splits), s.renderer.c_str());
+                 static_cast<unsigned long long>(s.splits), rendererName(s).c_str());
     for (const ReceiverMap& map : result.receivers)
       std::fprintf(stderr, "lightsim: receiver '%s': %d x %d texels of %.4g, %.4g W of %.4g W received\n",
                    map.name.c_str(), map.texels.x, map.texels.y, map.pitch, luminance(s.flux_received),

@@ -175,6 +175,7 @@ struct SimulationStats {
   double ledgerResidual() const;
   std::string backend;               // "gl" or "cpu"
   std::string renderer;              // GL renderer string or "cpu, N threads"
+  std::string simd;                  // CPU twin: the SIMD target of its track deposits ("AVX3", …)
   nlohmann::json toJson() const;
 };
 

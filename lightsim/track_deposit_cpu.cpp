@@ -9,6 +9,7 @@
 #endif
 #include <hwy/foreach_target.h>  // before highway.h
 #include <hwy/highway.h>
+#include <hwy/contrib/math/math-inl.h>
 
 #include <algorithm>
 #include <array>
@@ -49,15 +50,35 @@ HWY_INLINE void addWeighted2(double* HWY_RESTRICT sum, const double* HWY_RESTRIC
               sum + i);
 }
 
-// exp(−x) per channel of the first three lanes. A step's decay is mostly small (x ≤ ¼: a few
-// voxels of absorption, a Fresnel loss), where the Taylor series to x⁵ is within 3.4·10⁻⁷ (x⁶/720)
-// at a sixth of the cost.
-HWY_INLINE void decayFactor(const double* x, double* f) {
-  for (int c = 0; c < 3; ++c) {
-    const double v = x[c];
-    f[c] = std::fabs(v) <= 0.25 ? 1.0 - v * (1.0 - v * (0.5 - v * (1.0 / 6.0 - v * (1.0 / 24.0 - v * (1.0 / 120.0)))))
-                                : std::exp(-v);
+// A decaying flux's sums at one Gauss node t, the lanes of coef (DepositSum's order):
+// E·e^(−κt) per channel, and the direction sum D scaled by the luminance of that decayed flux,
+// Σ_c share_c·e^(−κ_c t). k4 = (κ_r, κ_g, κ_b, 0), e4 = (E, 0), d4 = (D, 0), share4 = (Φ_c/Σ Φ, 0).
+// A step's decay is mostly small (κt ≤ ¼: a few voxels of absorption, a Fresnel loss), where the
+// Taylor series of e^(−x) to x⁵ is within 3.4·10⁻⁷ (x⁶/720) at a fraction of Exp's cost.
+HWY_INLINE void nodeCoefficients(const double* HWY_RESTRICT k4, const double* HWY_RESTRICT e4,
+                                 const double* HWY_RESTRICT d4, const double* HWY_RESTRICT share4, double t,
+                                 bool taylor, double* HWY_RESTRICT coef) {
+  const hn::CappedTag<double, 4> d;
+  const auto vt = hn::Set(d, t);
+  auto dot = hn::Zero(d);
+  for (std::size_t i = 0; i < 4; i += hn::Lanes(d)) {
+    const auto x = hn::Mul(hn::Load(d, k4 + i), vt);
+    hn::Vec<decltype(d)> f;
+    if (taylor) {
+      // 1 − x(1 − x(½ − x(1/6 − x(1/24 − x/120)))), by Horner's rule.
+      f = hn::NegMulAdd(x, hn::Set(d, 1.0 / 120.0), hn::Set(d, 1.0 / 24.0));
+      f = hn::NegMulAdd(x, f, hn::Set(d, 1.0 / 6.0));
+      f = hn::NegMulAdd(x, f, hn::Set(d, 0.5));
+      f = hn::NegMulAdd(x, f, hn::Set(d, 1.0));
+      f = hn::NegMulAdd(x, f, hn::Set(d, 1.0));
+    } else {
+      f = hn::Exp(d, hn::Neg(x));
+    }
+    hn::Store(hn::Mul(hn::Load(d, e4 + i), f), d, coef + i);
+    dot = hn::MulAdd(hn::Load(d, share4 + i), f, dot);
   }
+  const auto scale = hn::SumOfLanes(d, dot);
+  for (std::size_t i = 0; i < 4; i += hn::Lanes(d)) hn::Store(hn::Mul(hn::Load(d, d4 + i), scale), d, coef + 4 + i);
 }
 
 // The sub-paths of the patch-steps in `list` (patch order), within slab `slab`'s voxels.
@@ -102,6 +123,10 @@ void depositSlab(const std::vector<Patch>& patches, const std::vector<PatchStepR
     const double lum = luminance(flux);
     // A node's direction sum scales with the luminance of its decayed flux: Σ flux_c f_c / Σ flux_c.
     const glm::dvec3 lum_share = lum > 0.0 ? flux / (3.0 * lum) : glm::dvec3(0.0);
+    alignas(32) const double k4[4] = {kappa[0], kappa[1], kappa[2], 0.0};
+    alignas(32) const double share4[4] = {lum_share.x, lum_share.y, lum_share.z, 0.0};
+    // κt ≤ ¼ at every node (t ≤ 1): the Taylor series serves the whole step.
+    const bool taylor = std::max({std::fabs(kappa[0]), std::fabs(kappa[1]), std::fabs(kappa[2])}) <= 0.25;
     // The corners in voxel coordinates: the bilinear patch commutes with the affine map to them, so
     // each sub-path's ends are found there directly; world lengths are voxel spans times h.
     std::array<glm::dvec3, 4> from_voxel, to_voxel;
@@ -156,21 +181,14 @@ void depositSlab(const std::vector<Patch>& patches, const std::vector<PatchStepR
         const glm::dvec3 e = flux * (length * inv_volume * share);
         const glm::dvec3 dsum = (lum * share) * step;
         if (decays) {
+          alignas(32) const double e4[4] = {e.x, e.y, e.z, 0.0}, d4[4] = {dsum.x, dsum.y, dsum.z, 0.0};
           // Per Gauss node n: the flux there, Φ·exp(−κ t_n), in both sums.
           forEachTrackCell<true>(
               va, vb, grid.dims,
               [&](const TrackCell& c) {
                 alignas(64) double coef[2][kSumLanes];
-                for (int n = 0; n < 2; ++n) {
-                  const double t = c.node_t[static_cast<std::size_t>(n)];
-                  const double x[3] = {kappa[0] * t, kappa[1] * t, kappa[2] * t};
-                  double f[3];
-                  decayFactor(x, f);
-                  const double dir_scale = lum_share.x * f[0] + lum_share.y * f[1] + lum_share.z * f[2];
-                  double* cn = coef[n];
-                  cn[0] = e.x * f[0], cn[1] = e.y * f[1], cn[2] = e.z * f[2], cn[3] = 0.0;
-                  cn[4] = dsum.x * dir_scale, cn[5] = dsum.y * dir_scale, cn[6] = dsum.z * dir_scale, cn[7] = 0.0;
-                }
+                for (int n = 0; n < 2; ++n)
+                  nodeCoefficients(k4, e4, d4, share4, c.node_t[static_cast<std::size_t>(n)], taylor, coef[n]);
                 const bool whole = c.interior && c.cell.z >= z0 && c.cell.z + 1 < z1;
                 for (int k = 0; k < 8; ++k) {
                   if (!whole && !cornerIn(c, k)) continue;
