@@ -62,9 +62,89 @@ void orthonormalBasis(glm::dvec3 n, glm::dvec3& u, glm::dvec3& v) {
 }
 
 struct Tally {
-  std::vector<double> rings, map;
-  double received = 0.0, escaped = 0.0, dropped = 0.0;
+  std::vector<double> rings, map, fluence;
+  double received = 0.0, escaped = 0.0, dropped = 0.0, absorbed = 0.0;
 };
+
+// The fluence of one straight piece of path, origin + t·dir (dir unit) for t0 ≤ t ≤ t1, carrying
+// flux·e^(−σ (t − t0)): clipped to the grid's box, then cut at the cells' faces (a 3D DDA), each
+// part's ∫ flux e^(−σ (t − t0)) dt added to its cell over the cell's volume.
+void tallyFluence(const FluenceGrid& grid, glm::dvec3 origin, glm::dvec3 dir, double t0, double t1, double flux,
+                  double sigma, bool in_solid, std::vector<double>& fluence) {
+  if (grid.dims.x <= 0 || !(t1 > t0) || (grid.solids_only && !in_solid)) return;
+  const glm::dvec3 cell = (grid.hi - grid.lo) / glm::dvec3(grid.dims);
+  // The hats of the outermost cells reach half a cell beyond the grid.
+  const glm::dvec3 lo = grid.hat ? grid.lo - 0.5 * cell : grid.lo, hi = grid.hat ? grid.hi + 0.5 * cell : grid.hi;
+  double a = t0, b = std::isfinite(t1) ? t1 : 1e30;
+  for (int k = 0; k < 3; ++k) {
+    if (dir[k] == 0.0) {
+      if (origin[k] < lo[k] || origin[k] > hi[k]) return;
+      continue;
+    }
+    double ta = (lo[k] - origin[k]) / dir[k], tb = (hi[k] - origin[k]) / dir[k];
+    if (ta > tb) std::swap(ta, tb);
+    a = std::max(a, ta);
+    b = std::min(b, tb);
+  }
+  if (!(b > a)) return;
+  const double volume = cell.x * cell.y * cell.z;
+  if (grid.hat) {
+    const glm::dvec3 span = (b - a) * dir / cell;
+    const int samples = std::max(1, static_cast<int>(std::ceil(8.0 * (std::fabs(span.x) + std::fabs(span.y) + std::fabs(span.z)))));
+    const double ds = (b - a) / samples;
+    for (int i = 0; i < samples; ++i) {
+      const double t = a + (i + 0.5) * ds;
+      const double weight = flux * (sigma > 0.0 ? std::exp(-sigma * (t - t0)) : 1.0) * ds / volume;
+      const glm::dvec3 f = (origin + t * dir - grid.lo) / cell - 0.5;  // cell centres at integers
+      const glm::dvec3 base = glm::floor(f), frac = f - base;
+      for (int corner = 0; corner < 8; ++corner) {
+        const glm::ivec3 o(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+        const glm::ivec3 c = glm::ivec3(base) + o;
+        if (c.x < 0 || c.y < 0 || c.z < 0 || c.x >= grid.dims.x || c.y >= grid.dims.y || c.z >= grid.dims.z) continue;
+        const double w = (o.x ? frac.x : 1.0 - frac.x) * (o.y ? frac.y : 1.0 - frac.y) * (o.z ? frac.z : 1.0 - frac.z);
+        fluence[static_cast<std::size_t>(c.x + grid.dims.x * (c.y + grid.dims.y * c.z))] += weight * w;
+      }
+    }
+    return;
+  }
+  glm::ivec3 c, step;
+  glm::dvec3 next, every;
+  const glm::dvec3 pa = origin + a * dir;
+  for (int k = 0; k < 3; ++k) {
+    // The cell the piece starts in (just past its entry point along dir).
+    const double f = (pa[k] - grid.lo[k]) / cell[k];
+    int ck = static_cast<int>(std::floor(f));
+    if (dir[k] < 0.0 && f == std::floor(f)) ck -= 1;
+    c[k] = std::clamp(ck, 0, grid.dims[k] - 1);
+    if (dir[k] > 0.0) {
+      step[k] = 1;
+      every[k] = cell[k] / dir[k];
+      next[k] = (grid.lo[k] + (c[k] + 1) * cell[k] - origin[k]) / dir[k];
+    } else if (dir[k] < 0.0) {
+      step[k] = -1;
+      every[k] = -cell[k] / dir[k];
+      next[k] = (grid.lo[k] + c[k] * cell[k] - origin[k]) / dir[k];
+    } else {
+      step[k] = 0;
+      every[k] = kInfinity;
+      next[k] = kInfinity;
+    }
+  }
+  double t = a;
+  while (t < b) {
+    const int k = next.x <= next.y ? (next.x <= next.z ? 0 : 2) : (next.y <= next.z ? 1 : 2);
+    const double te = std::min(b, next[k]);
+    if (te > t) {
+      const double length = te - t;
+      const double part = sigma > 0.0 ? std::exp(-sigma * (t - t0)) * -std::expm1(-sigma * length) / sigma : length;
+      fluence[static_cast<std::size_t>(c.x + grid.dims.x * (c.y + grid.dims.y * c.z))] += flux * part / volume;
+    }
+    t = te;
+    c[k] += step[k];
+    next[k] += every[k];
+    if (c[k] < 0 || c[k] >= grid.dims[k]) break;
+  }
+}
 
 void tallyOnReceiver(const Receiver& receiver, glm::dvec3 p, double flux, Tally& tally) {
   tally.received += flux;
@@ -86,8 +166,8 @@ void tallyOnReceiver(const Receiver& receiver, glm::dvec3 p, double flux, Tally&
 }
 
 // Follows one ray from the light until the receiver absorbs it, it escapes or it is dropped.
-void tracePath(const std::vector<Solid>& solids, const Receiver& receiver, glm::dvec3 origin, glm::dvec3 dir,
-               double flux, int max_interactions, RayRandom& random, Tally& tally) {
+void tracePath(const std::vector<Solid>& solids, const Receiver& receiver, const FluenceGrid& grid, glm::dvec3 origin,
+               glm::dvec3 dir, double flux, int max_interactions, RayRandom& random, Tally& tally) {
   constexpr double kEpsilon = 1e-9;
   int inside = -1;  // index of the solid the ray is in, -1 in air
   for (int interaction = 0; interaction <= max_interactions; ++interaction) {
@@ -108,6 +188,7 @@ void tracePath(const std::vector<Solid>& solids, const Receiver& receiver, glm::
       if (facing < 0.0) {
         const double t_plane = glm::dot(receiver.point - origin, receiver.normal) / facing;
         if (t_plane > 0.0 && t_plane < nearest.t) {
+          tallyFluence(grid, origin, dir, 0.0, t_plane, flux, 0.0, false, tally.fluence);
           tallyOnReceiver(receiver, origin + t_plane * dir, flux, tally);
           return;
         }
@@ -115,8 +196,17 @@ void tracePath(const std::vector<Solid>& solids, const Receiver& receiver, glm::
     }
     if (nearest_solid < 0) {
       // Inside a solid with no exit can only be rounding at a grazing hit: count it as escaped.
+      if (inside < 0) tallyFluence(grid, origin, dir, 0.0, kInfinity, flux, 0.0, false, tally.fluence);
       tally.escaped += flux;
       return;
+    }
+    // The piece up to the surface, absorbed on the way inside a solid.
+    const double sigma = inside >= 0 ? solids[static_cast<std::size_t>(inside)].sigma_a : 0.0;
+    tallyFluence(grid, origin, dir, 0.0, nearest.t, flux, sigma, inside >= 0, tally.fluence);
+    if (sigma > 0.0) {
+      const double kept = std::exp(-sigma * nearest.t);
+      tally.absorbed += flux * (1.0 - kept);
+      flux *= kept;
     }
     const Solid& solid = solids[static_cast<std::size_t>(nearest_solid)];
     const glm::dvec3 p = origin + nearest.t * dir;
@@ -287,9 +377,14 @@ ReceiverTally trace(const std::vector<Solid>& solids, const DirectionalBeam& bea
   int threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
   threads = std::max(1, threads);
   std::vector<Tally> tallies(static_cast<std::size_t>(threads));
+  const std::size_t cells = options.fluence.dims.x > 0 ? static_cast<std::size_t>(options.fluence.dims.x) *
+                                                              static_cast<std::size_t>(options.fluence.dims.y) *
+                                                              static_cast<std::size_t>(options.fluence.dims.z)
+                                                        : 0;
   for (Tally& t : tallies) {
     t.rings.assign(rings, 0.0);
     t.map.assign(texels, 0.0);
+    t.fluence.assign(cells, 0.0);
   }
   auto work = [&](int thread) {
     Tally& tally = tallies[static_cast<std::size_t>(thread)];
@@ -297,7 +392,7 @@ ReceiverTally trace(const std::vector<Solid>& solids, const DirectionalBeam& bea
       const glm::dvec2 disc = concentricDisc(r2Point(i, s0, s1)) * beam.beam_radius;
       const glm::dvec3 origin = beam.beam_center + disc.x * u + disc.y * v - back * d;
       RayRandom random(options.seed, i);
-      tracePath(solids, receiver, origin, d, flux_per_ray, options.max_interactions, random, tally);
+      tracePath(solids, receiver, options.fluence, origin, d, flux_per_ray, options.max_interactions, random, tally);
     }
   };
   std::vector<std::thread> pool;
@@ -313,7 +408,10 @@ ReceiverTally trace(const std::vector<Solid>& solids, const DirectionalBeam& bea
   result.map_texels = receiver.map_texels;
   result.rays = options.rays;
   result.flux_emitted = flux_per_ray * static_cast<double>(options.rays);
+  result.fluence.assign(cells, 0.0);
   for (const Tally& t : tallies) {
+    for (std::size_t i = 0; i < cells; ++i) result.fluence[i] += t.fluence[i];
+    result.flux_absorbed += t.absorbed;
     for (std::size_t i = 0; i < rings; ++i) result.ring_flux[i] += t.rings[i];
     for (std::size_t i = 0; i < texels; ++i) result.map_flux[i] += t.map[i];
     result.flux_received += t.received;

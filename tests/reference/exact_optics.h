@@ -30,6 +30,7 @@ struct Hit {
 // {x : dot(normal_i, x) <= offset_i}.
 struct Solid {
   double ior = 1.5;
+  double sigma_a = 0.0;  // absorption coefficient inside (1/m, grey): flux × e^(−σa s) along a path s
   bool is_sphere = true;
   glm::dvec3 center{0.0};
   double radius = 1.0;
@@ -75,7 +76,22 @@ struct Receiver {
   glm::dvec2 map_origin{0.0};
 };
 
+// A grid of cells over [lo, hi] (dims cells an axis) on which the tracer tallies the fluence rate
+// (W/m²), ∫ Φ(s) K(x(s)) ds over the paths, over a cell's volume, with one of two windows K:
+//  - box (hat = false): the cell itself, exactly (the paths are cut at the cells' faces, the decay
+//    integrated in closed form);
+//  - hat (hat = true): the trilinear hat around the cell's centre, reaching the neighbours' centres
+//    (the window of a voxel of a baked volume), by the midpoint rule on 8 samples a cell's edge
+//    along each path (its error, where a sample straddles a kink of the hat, averages out over rays).
+struct FluenceGrid {
+  glm::dvec3 lo{0.0}, hi{0.0};
+  glm::ivec3 dims{0};
+  bool hat = false;
+  bool solids_only = false;  // tally the paths inside the solids only (not in the air)
+};
+
 struct TraceOptions {
+  FluenceGrid fluence;  // dims 0: no fluence tally
   std::uint64_t rays = 1'000'000;
   std::uint64_t seed = 1;
   int max_interactions = 64;  // a path still bouncing after this many surface hits is dropped
@@ -92,6 +108,8 @@ struct ReceiverTally {
   double flux_received = 0.0;     // W absorbed by the receiver plane (anywhere)
   double flux_escaped = 0.0;      // W that left towards infinity
   double flux_dropped = 0.0;      // W of paths cut at max_interactions
+  double flux_absorbed = 0.0;     // W absorbed inside the solids (σa)
+  std::vector<double> fluence;    // TraceOptions::fluence's cells (x fastest), W/m²
   std::uint64_t rays = 0;
 
   // Planar irradiance (W/m²) averaged over the annulus r0 ≤ r < r1 (multiples of ring_width).
