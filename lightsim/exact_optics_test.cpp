@@ -770,14 +770,16 @@ SphereFluence absorbingSphereFluence(int res, int block, bool straight) {
   return out;
 }
 
-// Measured (800 k rays): steps of Δt, mean block deviation 1.6 % at 32³ and 1.3 % at 48³, the
-// absorbed flux −1.3 % and −0.7 % (converging); straight steps at 48³ 2.1 % and −1.2 %. The worst
-// blocks, 8–10 % short with steps of Δt and 21 % with straight steps, are the lower outer glass that
+// Measured (800 k rays): steps of Δt, mean block deviation 1.4 % at 32³ and 1.1 % at 48³, the
+// absorbed flux −1.1 % and −0.6 % (converging); straight steps at 48³ 1.3 % and −0.7 %. The worst
+// blocks, 5–7 % short with steps of Δt and 12 % with straight steps, are the lower outer glass that
 // only rays entering near the silhouette reach: patches there are torn across the surface and
 // killed at the depth limit (0.3 % of the flux in, `flux_killed`; a depth of 9 instead of 6 takes
-// the worst block to 6 %). Tolerances sit above these by the tracer's noise in those dim blocks
-// (±1.5 % between 0.4 M and 2 M rays); a wrong decay, deposit or refraction is off everywhere,
-// by 7–10 % in the mean (the staircase this bake had before its track decay).
+// the worst block from 10 to 6 %). Tolerances sit above these by the tracer's noise in those dim
+// blocks (±1.5 % between 0.4 M and 2 M rays). A wrong decay, deposit or refraction is off
+// everywhere, by 7–10 % in the mean (the staircase this bake had before its track decay), and the
+// reflected wavefront's corners lost behind a thin rim (interface_crossing.cpp reflectedPatch, before
+// it searched back in pieces) read 2.1 % in the mean and 19 % in the worst block with straight steps.
 TEST(ExactOpticsSphere, VolumeIrradianceInAnAbsorbingSphereMatchesTheTracer) {
   const SphereFluence coarse = absorbingSphereFluence(32, 3, false);
   const SphereFluence fine = absorbingSphereFluence(48, 4, false);
@@ -789,15 +791,15 @@ TEST(ExactOpticsSphere, VolumeIrradianceInAnAbsorbingSphereMatchesTheTracer) {
   EXPECT_GT(fine.blocks, 200);
   EXPECT_LT(coarse.mean, 0.02);
   EXPECT_LT(fine.mean, coarse.mean);  // converging
-  EXPECT_LT(straight.mean, 0.03);
-  EXPECT_LT(coarse.worst, 0.12);
-  EXPECT_LT(fine.worst, 0.12);
-  EXPECT_LT(straight.worst, 0.25);
+  EXPECT_LT(straight.mean, 0.018);
+  EXPECT_LT(coarse.worst, 0.09);
+  EXPECT_LT(fine.worst, 0.09);
+  EXPECT_LT(straight.worst, 0.15);
   const double coarse_absorbed = coarse.absorbed / coarse.absorbed_exact - 1.0;
   const double fine_absorbed = fine.absorbed / fine.absorbed_exact - 1.0;
   EXPECT_LT(std::fabs(coarse_absorbed), 0.02);
   EXPECT_LT(std::fabs(fine_absorbed), std::fabs(coarse_absorbed));  // converging
-  EXPECT_LT(std::fabs(straight.absorbed / straight.absorbed_exact - 1.0), 0.02);
+  EXPECT_LT(std::fabs(straight.absorbed / straight.absorbed_exact - 1.0), 0.01);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -189,9 +189,18 @@ bool reflectedPatch(const Patch& transmitted, const VolumeSampler& sampler, doub
     const glm::dvec3 x = transmitted.x[c];
     const glm::dvec3 d = glm::normalize(transmitted.w[c]);
     const int medium = transmitted.medium[c];
+    // Back along the ray in pieces of at most two voxels, nearest first: a chord is asked for the
+    // material at its end, so one long chord through a thin part of the object (near a sphere's
+    // rim) ends in the corner's own material and finds nothing.
     InterfaceHit hit;
-    if (!findInterface(sampler, x, x - reach * d, medium, hit) || hit.entered == medium) return false;
-    const glm::dvec3 p = x - (hit.fraction * reach) * d;
+    double back_by = -1.0;  // distance from x back to the interface
+    const double piece = 2.0 * sampler.h();
+    for (double done = 0.0; done < reach && back_by < 0.0; done += piece) {
+      const double length = std::min(piece, reach - done);
+      if (findInterface(sampler, x - done * d, x - (done + length) * d, medium, hit)) back_by = done + hit.fraction * length;
+    }
+    if (back_by < 0.0 || hit.entered == medium) return false;
+    const glm::dvec3 p = x - back_by * d;
     const glm::dvec3 normal = sampler.interfaceNormal(hit.slot, p);
     if (glm::dot(normal, normal) == 0.0 || sampler.opaque(hit.entered)) return false;
     const double n2 = sampler.materialOptics(medium, p).x, n1 = sampler.materialOptics(hit.entered, p).x;
@@ -201,7 +210,7 @@ bool reflectedPatch(const Patch& transmitted, const VolumeSampler& sampler, doub
     const glm::dvec3 incident = -back.direction;
     const glm::dvec3 r = mirror(incident, normal);
     // Time since the crossing: distance·n2 in the transmitted material; as far along r at speed 1/n1.
-    const double travelled = hit.fraction * reach * n2 / n1;
+    const double travelled = back_by * n2 / n1;
     reflected.x[c] = p + travelled * r;
     reflected.w[c] = n1 * r;
     reflected.medium[c] = hit.entered;

@@ -66,7 +66,8 @@ CornerCrossings advanceCornerSharp(glm::dvec3& x, glm::dvec3& w, int& medium, gl
 
 // The wavefront Fresnel reflection sends back at an interface every corner of `transmitted` has
 // crossed (ALGORITHM.md "Bounces"): each corner is traced back along its ray to the interface it
-// crossed last (within `reach` world units), the incident direction recovered by Snell's law in
+// crossed last (within `reach` world units, searched in pieces of two voxels, nearest first), the
+// incident direction recovered by Snell's law in
 // reverse, mirrored, and the corner moved as far along the mirror ray, in the time it has spent
 // since the crossing, as the transmitted one went ahead. Flux, depth and A₀ are the caller's. False
 // when a corner finds no interface behind it (then no reflection is followed).

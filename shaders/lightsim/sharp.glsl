@@ -242,10 +242,18 @@ bool reflectedPatch(Patch p, float reach, out Patch r) {
     vec3 x = p.x[c];
     vec3 d = normalize(p.w[c]);
     int medium = p.medium[c];
+    // Back along the ray in pieces of at most two voxels, nearest first (interface_crossing.cpp: a
+    // long chord through a thin part of the object ends in the corner's own material).
     float f;
     int slot, entered;
-    if (!findInterface(x, x - reach * d, medium, f, slot, entered) || entered == medium) return false;
-    vec3 q = x - (f * reach) * d;
+    float back_by = -1.0;
+    float piece = 2.0 * uVoxelEdge;
+    for (float done = 0.0; done < reach && back_by < 0.0; done += piece) {
+      float len = min(piece, reach - done);
+      if (findInterface(x - done * d, x - (done + len) * d, medium, f, slot, entered)) back_by = done + f * len;
+    }
+    if (back_by < 0.0 || entered == medium) return false;
+    vec3 q = x - back_by * d;
     vec3 normal = interfaceNormal(slot, q);
     if (dot(normal, normal) == 0.0 || slotOpaque(entered)) return false;
     float n2 = materialOptics(medium, q).x, n1 = materialOptics(entered, q).x;
@@ -254,7 +262,7 @@ bool reflectedPatch(Patch p, float reach, out Patch r) {
     if (refractAt(-d, normal, n2, n1, back, unused)) return false;
     vec3 incident = -back;
     vec3 m = incident - 2.0 * dot(incident, normal) * normal;
-    float travelled = f * reach * n2 / n1;
+    float travelled = back_by * n2 / n1;
     r.x[c] = q + travelled * m;
     r.w[c] = n1 * m;
     r.medium[c] = entered;
