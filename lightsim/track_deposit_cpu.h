@@ -56,7 +56,8 @@ std::vector<std::string> trackDepositTargets();
 std::string trackDepositTarget();
 // Runs the deposits on the named target from now on (one of trackDepositTargets()); "" or "best":
 // the best one again. Throws InputError for a name that is not in the list. The environment
-// variable EIKONAL_SIMD, read at the first deposit, does the same (benchmarks: a target's share).
+// variable EIKONAL_SIMD, read at the first deposit, picks one the same way (benchmarks: a target's
+// share); a name not in the list leaves the best (trackDepositTarget and the stats say which).
 void setTrackDepositTarget(const std::string& name);
 
 }  // namespace eik
