@@ -147,6 +147,21 @@ TEST_F(GlObjects, UniformSettersKeepTheProgramInUse) {
   EXPECT_EQ(value[1], 4.0f);
 }
 
+// A program destroyed while in use is not left current: the next program's uniform setter saves
+// and restores the current program, and restoring a deleted one was GL_INVALID_VALUE (found as an
+// order-dependent failure of lightsim_tests run as one process).
+TEST_F(GlObjects, AProgramDestroyedInUseIsNotLeftCurrent) {
+  ShaderLibrary library;
+  {
+    Program a = library.program("common/fullscreen.vert", "test/pattern.frag");
+    a.use();
+  }
+  EXPECT_EQ(getInt(GL_CURRENT_PROGRAM), 0);
+  Program b = library.program("common/fullscreen.vert", "test/pattern.frag", {{"MODE", "1"}});
+  EXPECT_NO_THROW(b.set("uSize", glm::vec2(3.0f, 4.0f)));
+  EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
 TEST_F(GlObjects, IncompleteFramebufferSaysWhy) {
   Framebuffer empty({4, 4});
   try {

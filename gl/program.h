@@ -27,7 +27,16 @@ struct ShaderTraits {
   static void destroy(GLuint name) { glDeleteShader(name); }
 };
 struct ProgramTraits {
-  static void destroy(GLuint name) { glDeleteProgram(name); }
+  // A program deleted while it is current stays in use, only flagged for deletion, until another
+  // one is made current; code that saved it as "the current program" and restores it afterwards
+  // (Program::set, ScopedPassState) would then restore a name that no longer exists
+  // (GL_INVALID_VALUE in glUseProgram). So a program in use is unbound before it is deleted.
+  static void destroy(GLuint name) {
+    GLint current = 0;
+    glGetIntegerv(GL_CURRENT_PROGRAM, &current);
+    if (static_cast<GLuint>(current) == name) glUseProgram(0);
+    glDeleteProgram(name);
+  }
 };
 }  // namespace detail
 
