@@ -40,6 +40,7 @@ void AnalysisPass::run(const PatchTextures& current, const PatchTextures& previo
   grid.set(program_);
   program_.set("uDt", step.dt);
   program_.set("uStepDt", step.stepDt);
+  program_.set("uReflectedStepDt", step.reflectedStepDt);
   program_.set("uFluxKill", step.fluxKill);
   program_.set("uSplitLength", step.splitLength);
   program_.set("uMaxDepth", step.maxDepth);

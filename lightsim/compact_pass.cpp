@@ -11,7 +11,7 @@ CompactPass::CompactPass(const gl::ShaderLibrary& library, const gl::ShaderDefin
     : program_(library.program("common/fullscreen.vert", "lightsim/compact.frag", pyramidDefines, volumeDefines)) {}
 
 void CompactPass::run(const PatchTextures& in, const StepTargets& targets, PatchTextures& out, std::size_t slots,
-                      const gl::VolumeTextures& volume, const GridUniforms& grid, float dt) const {
+                      const gl::VolumeTextures& volume, const GridUniforms& grid, float dt, float reflectedDt) const {
   gl::ScopedPassBindings unbind;
   out.framebuffer().bind();
   viewportLiveBox(slots);
@@ -24,6 +24,7 @@ void CompactPass::run(const PatchTextures& in, const StepTargets& targets, Patch
   volume.bind(program_, unit);
   grid.set(program_);
   program_.set("uDt", dt);
+  program_.set("uReflectedDt", reflectedDt > 0.0f ? reflectedDt : dt);
   triangle_.draw();
   gl::checkErrors("CompactPass");
 }

@@ -34,10 +34,12 @@ class CompactPass {
   // pyramidDefines: HistoPyramid::defines() of the pyramids it will read (their levels).
   CompactPass(const gl::ShaderLibrary& library, const gl::ShaderDefines& pyramidDefines,
               const std::string& volumeDefines);
-  // dt: an ordinary step's time, Δt or a straight step's (StepUniforms::stepDt): with sharp
-  // interfaces the reach of a followed reflection, 4·dt + 2h (sharp.glsl reflectedPatch).
+  // dt: an ordinary step's time, Δt or a straight step's (StepUniforms::stepDt), reflectedDt a
+  // reflected wavefront's (StepUniforms::reflectedStepDt; 0: dt): with sharp interfaces the reach
+  // of a followed reflection, 4·dt + 2h (sharp.glsl reflectedPatch).
   void run(const PatchTextures& in, const StepTargets& targets, PatchTextures& out, std::size_t slots,
-           const gl::VolumeTextures& volume, const GridUniforms& grid, float dt = 0.0f) const;
+           const gl::VolumeTextures& volume, const GridUniforms& grid, float dt = 0.0f,
+           float reflectedDt = 0.0f) const;
 
  private:
   gl::Program program_;

@@ -114,6 +114,9 @@ StepContext makeStepContext(const VolumeSampler& sampler, const SimulationOption
   ctx.options = &options;
   ctx.dt = timeStep(sampler.grid(), options);
   ctx.step_dt = straightSteps(sampler, options) ? options.straight_step_voxels * voxelEdge(sampler.grid()) : ctx.dt;
+  ctx.reflected_step_dt = ctx.step_dt;
+  if (ctx.step_dt > ctx.dt && (!sampler.hasAbsorption() || sampler.absorptionPerMaterial()))
+    ctx.reflected_step_dt = kReflectedStepFactor * ctx.step_dt;
   ctx.retake_at_interfaces = ctx.step_dt > ctx.dt && options.volume_deposits;
   // A path of time t has length t/n (|dx/dt| = 1/n): at most this far from where it starts.
   ctx.straight_reach = ctx.step_dt / std::min(1.0, sampler.minIor());
@@ -193,11 +196,18 @@ SharpUpdate updateCornersSharp(Patch& patch, PatchSamples& samples, const StepCo
 // midpoint is 0 along the whole step, as it is); else Δt.
 double sharpStepTime(const Patch& patch, const StepContext& ctx) {
   if (!(ctx.step_dt > ctx.dt)) return ctx.dt;
-  if (!ctx.sampler->hasAbsorption() || ctx.sampler->absorptionPerMaterial()) return ctx.step_dt;
+  if (!ctx.sampler->hasAbsorption() || ctx.sampler->absorptionPerMaterial())
+    return patch.bounce > 0 ? ctx.reflected_step_dt : ctx.step_dt;
   if (!ctx.absorbers) return ctx.dt;
   glm::dvec3 lo = patch.x[0], hi = patch.x[0];
   for (int c = 1; c < 4; ++c) lo = glm::min(lo, patch.x[c]), hi = glm::max(hi, patch.x[c]);
   return ctx.absorbers->quiet(lo - ctx.straight_reach, hi + ctx.straight_reach) ? ctx.step_dt : ctx.dt;
+}
+
+// How far back reflectedPatch looks for the interface a patch's corners crossed: they crossed it
+// over up to four of its ordinary steps (a reflected wavefront's are longer), plus two voxels.
+double reflectionReach(const Patch& patch, const StepContext& ctx) {
+  return 4.0 * (patch.bounce > 0 ? ctx.reflected_step_dt : ctx.step_dt) + 2.0 * ctx.sampler->h();
 }
 
 // A patch meets an interface with some corners and not yet with the others. It will tear — the
@@ -411,7 +421,7 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
       if (patch.bounce < options.bounces && patch.reflect_pending > 0.0 && patch.reflect_pending < 1.0 &&
           std::max(reflected_flux.x, std::max(reflected_flux.y, reflected_flux.z)) >=
               fluxKillThreshold(ctx.flux_ref, options, static_cast<int>(patch.depth)) &&
-          reflectedPatch(patch, sampler, 4.0 * ctx.step_dt + 2.0 * h, reflection)) {
+          reflectedPatch(patch, sampler, reflectionReach(patch, ctx), reflection)) {
         result.reflection = std::make_unique<Patch>(reflection);
         result.spawn_reflection = true;
         result.reflection->flux = reflected_flux;

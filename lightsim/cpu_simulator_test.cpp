@@ -646,6 +646,35 @@ TEST(CpuSimulator, AReflectedWavefrontSplitsAtFourSplitLengths) {
   }
 }
 
+// ... and takes straight steps kReflectedStepFactor times as long (wavefront.h): a patch in the
+// middle of the block, going down, free flight off so that its ordinary step is a straight one;
+// a straight step of time t moves every corner t/n along its ray (|dx/dt| = 1/n). The GPU path's
+// step (flight.glsl sharpStepTime) is checked by its patch-steps against the twin's in
+// ExactOpticsSphere.TheGpuPathFliesAndTakesStraightStepsAsTheTwinDoes.
+TEST(CpuSimulator, AReflectedWavefrontTakesFourTimesLongerStraightSteps) {
+  const Volume v = sharpVolume("procedural:box,size=0.8:0.8:0.8,center=0:0:0,ior=1.5", 24, cube(0.5));
+  const VolumeSampler sampler(v);
+  SimulationOptions options;
+  options.free_flight = false;
+  options.straight_step_voxels = 2.0;  // the command's default
+  const StepContext ctx = makeStepContext(sampler, options, 1.0);
+  const double h = sampler.h();
+  ASSERT_DOUBLE_EQ(ctx.step_dt, options.straight_step_voxels * h);
+  for (const int bounce : {0, 1, 2}) {
+    Patch patch = squarePatchGoingDown(sampler, 0.01);
+    ASSERT_EQ(patch.medium[0], 0);  // inside the glass, 9.6 voxels from its faces
+    patch.bounce = bounce;
+    const glm::dvec3 before = patch.midpoint();
+    PatchSamples samples = samplePatch(patch, sampler);
+    const PatchStepResult r = stepPatch(patch, samples, ctx);
+    EXPECT_FALSE(r.flight);
+    const double want = (bounce > 0 ? kReflectedStepFactor : 1.0) * ctx.step_dt / 1.5;
+    // The step is straight and exact: only rounding separates the two.
+    EXPECT_NEAR(before.y - patch.midpoint().y, want, 1e-12) << "bounce " << bounce;
+    EXPECT_NEAR(glm::length(glm::dvec2(patch.midpoint().x - before.x, patch.midpoint().z - before.z)), 0.0, 1e-12);
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Timings for the report (not a test): --gtest_also_run_disabled_tests
 // --gtest_filter='*CpuBench*'. BENCH_RES (default 64) sets the sphere's resolution (voxels across

@@ -355,6 +355,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     // A straight step's time and reach, as the twin takes them (Δt where they do not apply).
     const StepContext twin = makeStepContext(sampler, options, fluxRef);
     step.stepDt = static_cast<float>(twin.step_dt);
+    step.reflectedStepDt = static_cast<float>(twin.reflected_step_dt);
     step.straightReach = static_cast<float>(twin.straight_reach);
     step.retakeAtInterfaces = twin.retake_at_interfaces;
   }
@@ -505,7 +506,8 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     if (slots > 0) {
       // Compaction writes the new list (into a grown set's: nothing to copy; the old set goes).
       timer.start("compact");
-      compact(L.targets.pyramid).run(L.b, L.targets, grown ? grown->a : L.a, slots, volume, gridUniforms, step.stepDt);
+      compact(L.targets.pyramid).run(L.b, L.targets, grown ? grown->a : L.a, slots, volume, gridUniforms, step.stepDt,
+                                     step.reflectedStepDt);
       timer.stop();
     }
     if (grown) {

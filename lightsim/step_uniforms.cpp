@@ -9,6 +9,7 @@ StepUniforms StepUniforms::from(const GridSpec& grid, const SimulationOptions& o
   StepUniforms step;
   step.dt = static_cast<float>(timeStep(grid, options));
   step.stepDt = step.dt;
+  step.reflectedStepDt = step.dt;
   step.boundaryOn = static_cast<float>(options.boundary_on);
   step.boundaryOff = static_cast<float>(options.boundary_off);
   step.fluxKill = static_cast<float>(options.flux_threshold * fluxRef);

@@ -17,6 +17,8 @@ struct StepUniforms {
   // they apply to the run (straightSteps, cpu_simulator.h), else Δt; and how far it reaches from
   // the corners (its time / min(1, min n)), the box the absorber map must find σa = 0 in.
   float stepDt = 0.0f, straightReach = 0.0f;
+  // A reflected wavefront's ordinary step (StepContext::reflected_step_dt); Δt here too.
+  float reflectedStepDt = 0.0f;
   // With volume deposits, a straight step in which a corner met an interface is retaken as a step
   // of Δt (StepContext::retake_at_interfaces, cpu_simulator.h).
   bool retakeAtInterfaces = false;

@@ -51,6 +51,7 @@ void UpdatePass::run(const PatchTextures& in, PatchTextures& out, const LiveCoun
   grid.set(program_);
   program_.set("uDt", step.dt);
   program_.set("uStepDt", step.stepDt);
+  program_.set("uReflectedStepDt", step.reflectedStepDt);
   program_.set("uStraightReach", step.straightReach);
   program_.set("uFlightCap", step.flightCap);
   program_.set("uFlightExtentVoxels", step.flightExtentVoxels);

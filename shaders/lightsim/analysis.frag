@@ -40,6 +40,7 @@ uniform sampler2D uPrevious[4];   // P0..P3 before the update
 uniform sampler2D uPreviousFlux;  // FLUX before the update
 uniform float uDt;                // Δt
 uniform float uStepDt;            // an ordinary step's time: Δt, or a straight step's (the reach of a reflection)
+uniform float uReflectedStepDt;    // a reflected wavefront's (StepContext::reflected_step_dt)
 
 layout(location = 0) out vec4 oCount;
 layout(location = 1) out vec4 oDepositA;
@@ -118,7 +119,7 @@ void main() {
     spawnFlux = p.flux * (p.reflectPending / (1.0 - p.reflectPending));
     Patch r;
     spawns = max(max(spawnFlux.r, spawnFlux.g), spawnFlux.b) >= uFluxKill * exp2(-2.0 * p.depth) &&
-             reflectedPatch(p, 4.0 * uStepDt + 2.0 * uVoxelEdge, r);
+             reflectedPatch(p, 4.0 * (p.bounce > 0 ? uReflectedStepDt : uStepDt) + 2.0 * uVoxelEdge, r);
   }
   int blocked = p.event / SHARP_EVENT_BLOCKED;
   bool splittable = oneMedium(p) && blocked == 0;

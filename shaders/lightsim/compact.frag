@@ -21,6 +21,7 @@
 #include "lightsim/fresnel.glsl"
 #include "lightsim/sharp.glsl"
 uniform float uDt;  // an ordinary step's time, Δt or a straight step's (the reach of reflectedPatch: 4 Δt + 2 h)
+uniform float uReflectedDt;  // a reflected wavefront's (StepContext::reflected_step_dt)
 #endif
 
 uniform sampler2D uPatch[8];   // the updated list (source)
@@ -57,7 +58,7 @@ void main() {
   if (reflection) {
     // The reflected wavefront (computed exactly as the analysis did when it counted the slot).
     Patch r;
-    reflectedPatch(p, 4.0 * uDt + 2.0 * uVoxelEdge, r);
+    reflectedPatch(p, 4.0 * (p.bounce > 0 ? uReflectedDt : uDt) + 2.0 * uVoxelEdge, r);
     r.flux = p.flux * (p.reflectPending / (1.0 - p.reflectPending));
     r.area0 = length(patchAreaVector(r));
     r.bounce = p.bounce + 1;

@@ -10,6 +10,7 @@
 // deposit pass reaches.
 
 uniform float uStepDt;        // a straight step's time (straight_step_voxels·h), or Δt when off
+uniform float uReflectedStepDt;  // a reflected wavefront's (StepContext::reflected_step_dt)
 uniform int uQuietBrick;      // voxels per brick edge
 #ifdef FREE_FLIGHT
 uniform usampler3D uQuietSat;
@@ -140,14 +141,17 @@ float freeFlightTime(Patch p) {
 #endif
 
 // sharpStepTime (cpu_simulator.cpp): a straight step where nothing absorbs within its reach of
-// the corners (with absorption; with σa per material anywhere: no absorber map then), else Δt.
-// uStepDt is Δt when straight steps are off.
+// the corners (with absorption; with σa per material anywhere: no absorber map then, and a
+// reflected wavefront's straight steps are longer), else Δt. uStepDt is Δt when straight steps
+// are off.
 float sharpStepTime(Patch p) {
   if (!(uStepDt > uDt)) return uDt;
 #ifdef ABSORBER_MAP
   vec3 lo = p.x[0], hi = p.x[0];
   for (int c = 1; c < 4; ++c) lo = min(lo, p.x[c]), hi = max(hi, p.x[c]);
   return boxQuiet(uAbsorberSat, lo - uStraightReach, hi + uStraightReach) ? uStepDt : uDt;
+#elif defined(SHARP_INTERFACES)
+  return p.bounce > 0 ? uReflectedStepDt : uStepDt;
 #else
   return uStepDt;
 #endif
