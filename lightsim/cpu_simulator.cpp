@@ -114,10 +114,13 @@ StepContext makeStepContext(const VolumeSampler& sampler, const SimulationOption
   ctx.options = &options;
   ctx.dt = timeStep(sampler.grid(), options);
   ctx.step_dt = straightSteps(sampler, options) ? options.straight_step_voxels * voxelEdge(sampler.grid()) : ctx.dt;
-  ctx.reflected_step_dt = ctx.step_dt;
-  if (ctx.step_dt > ctx.dt && (!sampler.hasAbsorption() || sampler.absorptionPerMaterial()))
-    ctx.reflected_step_dt = kReflectedStepFactor * ctx.step_dt;
   ctx.retake_at_interfaces = ctx.step_dt > ctx.dt && options.volume_deposits;
+  // With volume deposits a straight step that meets an interface is taken twice (retaken at Δt),
+  // and a longer one meets more of them: in the museum's cube 16 % more patch-steps. So there
+  // reflected wavefronts step as the others do.
+  ctx.reflected_step_dt = ctx.step_dt;
+  if (ctx.step_dt > ctx.dt && !ctx.retake_at_interfaces && (!sampler.hasAbsorption() || sampler.absorptionPerMaterial()))
+    ctx.reflected_step_dt = kReflectedStepFactor * ctx.step_dt;
   // A path of time t has length t/n (|dx/dt| = 1/n): at most this far from where it starts.
   ctx.straight_reach = ctx.step_dt / std::min(1.0, sampler.minIor());
   ctx.flux_ref = flux_ref;
