@@ -94,8 +94,7 @@ struct StepContext {
   // apply to the run (straightSteps), else Δt.
   double step_dt = 0.0;
   // …that of a reflected wavefront (bounce ≥ 1), kReflectedStepFactor times a straight step's where
-  // they apply, no absorber map decides and no volume deposits retake them (wavefront.h), else
-  // step_dt.
+  // they apply and no absorber map decides (wavefront.h), else step_dt; it is not retaken.
   double reflected_step_dt = 0.0;
   // …and, in a volume with absorption, the voxels that absorb (a straight step is taken only where
   // its reach, straight_reach world units around the corners, has σa = 0); none: Δt there.

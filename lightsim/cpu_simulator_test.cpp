@@ -646,22 +646,26 @@ TEST(CpuSimulator, AReflectedWavefrontSplitsAtFourSplitLengths) {
   }
 }
 
-// ... and takes straight steps kReflectedStepFactor times as long (wavefront.h), where no volume
-// deposits retake a straight step that meets an interface: a patch in the middle of the block,
-// going down, free flight off so that its ordinary step is a straight one; a straight step of time
-// t moves every corner t/n along its ray (|dx/dt| = 1/n). The GPU path's step (flight.glsl
-// sharpStepTime) is checked by its patch-steps against the twin's in
-// ExactOpticsSphere.TheGpuPathFliesAndTakesStraightStepsAsTheTwinDoes.
+// ... and takes straight steps kReflectedStepFactor times as long (wavefront.h), which with volume
+// deposits are not retaken at Δt where they meet an interface: a patch going down, free flight off
+// so that its ordinary step is a straight one; a straight step of time t moves every corner t/n
+// along its ray (|dx/dt| = 1/n). In the middle of the block the step is whole at any bounce; a
+// voxel above its bottom face a straight step (4/3 voxel in the glass) meets the face, and with volume deposits the
+// transmitted light's is retaken as a step of Δt, the reflected light's is not. The GPU path's
+// steps (flight.glsl sharpStepTime, update.frag) are checked by its patch-steps against the twin's
+// in ExactOpticsSphere.TheGpuPathFliesAndTakesStraightStepsAsTheTwinDoes.
 TEST(CpuSimulator, AReflectedWavefrontTakesFourTimesLongerStraightSteps) {
   const Volume v = sharpVolume("procedural:box,size=0.8:0.8:0.8,center=0:0:0,ior=1.5", 24, cube(0.5));
   const VolumeSampler sampler(v);
+  const double h = sampler.h();
   for (const bool volume_deposits : {false, true}) {
     SimulationOptions options;
     options.free_flight = false;
     options.straight_step_voxels = 2.0;  // the command's default
     options.volume_deposits = volume_deposits;
     const StepContext ctx = makeStepContext(sampler, options, 1.0);
-    ASSERT_DOUBLE_EQ(ctx.step_dt, options.straight_step_voxels * sampler.h());
+    ASSERT_DOUBLE_EQ(ctx.step_dt, options.straight_step_voxels * h);
+    ASSERT_DOUBLE_EQ(ctx.reflected_step_dt, kReflectedStepFactor * ctx.step_dt);
     for (const int bounce : {0, 1, 2}) {
       Patch patch = squarePatchGoingDown(sampler, 0.01);
       ASSERT_EQ(patch.medium[0], 0);  // inside the glass, 9.6 voxels from its faces
@@ -670,11 +674,27 @@ TEST(CpuSimulator, AReflectedWavefrontTakesFourTimesLongerStraightSteps) {
       PatchSamples samples = samplePatch(patch, sampler);
       const PatchStepResult r = stepPatch(patch, samples, ctx);
       EXPECT_FALSE(r.flight);
-      const double factor = bounce > 0 && !volume_deposits ? kReflectedStepFactor : 1.0;
+      const double factor = bounce > 0 ? kReflectedStepFactor : 1.0;
       // The step is straight and exact: only rounding separates the two.
       EXPECT_NEAR(before.y - patch.midpoint().y, factor * ctx.step_dt / 1.5, 1e-12)
           << "bounce " << bounce << ", volume deposits " << volume_deposits;
       EXPECT_NEAR(glm::length(glm::dvec2(patch.midpoint().x - before.x, patch.midpoint().z - before.z)), 0.0, 1e-12);
+    }
+    for (const int bounce : {0, 1}) {  // (without volume deposits the transmitted light's step tears here)
+      Patch patch = squarePatchGoingDown(sampler, 0.01);
+      for (glm::dvec3& x : patch.x) x.y += -0.4 + h - patch.midpoint().y;  // a voxel above the face
+      for (int c = 0; c < 4; ++c) ASSERT_EQ(sampler.materialAt(patch.x[c]), 0);
+      patch.bounce = bounce;
+      const glm::dvec3 before = patch.midpoint();
+      PatchSamples samples = samplePatch(patch, sampler);
+      const PatchStepResult r = stepPatch(patch, samples, ctx);
+      const double moved = before.y - patch.midpoint().y;
+      if (bounce > 0) {
+        EXPECT_GT(moved, h) << "volume deposits " << volume_deposits << ": through the face";
+      } else if (volume_deposits) {
+        EXPECT_FALSE(r.rolled_back);
+        EXPECT_NEAR(moved, ctx.dt / 1.5, 1e-12) << "retaken as a step of Δt";
+      }
     }
   }
 }

@@ -382,7 +382,8 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     trackUniforms.receiverPoint = step.receiverPoint;
     trackUniforms.receiverNormal = step.receiverNormal;
     trackUniforms.dimIrradiance = static_cast<float>(kDimTrackFraction * brightestIrradiance(light, grid));
-    const double step_voxels = std::max(options.step_voxels, static_cast<double>(step.stepDt) / voxelEdge(grid));
+    const double step_voxels = std::max({options.step_voxels, static_cast<double>(step.stepDt) / voxelEdge(grid),
+                                         static_cast<double>(step.reflectedStepDt) / voxelEdge(grid)});
     const double extent = 2.0 * kMaxUnsplitEdge * options.split_voxels + step_voxels;
     trackUniforms.maxExtentVoxels =
         std::min(trackPassFor().maxExtentVoxels(), static_cast<int>(std::ceil(1.5 * extent)) + 2);

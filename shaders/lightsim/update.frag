@@ -158,7 +158,7 @@ void main() {
         transmittance *= pow(cc.transmittance, 0.25);
         opticalDepth += 0.25 * cc.opticalDepth;
       }
-      if (!uRetakeAtInterfaces || metMask == 0 || !(stepTime > uDt)) break;
+      if (!uRetakeAtInterfaces || metMask == 0 || !(stepTime > uDt) || p.bounce > 0) break;  // not a reflected one's
       p = before;
       stepTime = uDt;
       transmittance = 1.0;
