@@ -346,9 +346,10 @@ constexpr double kReflectedSplitFactor = 4.0;
 // wavefront's resolution between splits, which matters in proportion to the flux. Measured with
 // the default one bounce: the 128³ sphere over a floor 24 % fewer patch-steps and its rings against
 // exact optics the same to three digits; the wine glass 33 % fewer patch-steps, 23 % faster, its
-// map within 1.6·10⁻³ relative L2; the logo block half the patch-steps. Not with volume deposits,
-// where a straight step that meets an interface is retaken (StepContext::reflected_step_dt).
-// BENCHMARKS.md, issue 13 nineteenth part.
+// map within 1.6·10⁻³ relative L2; the logo block, the layered cube and the museum's cube half the
+// patch-steps, their fields within 2.4·10⁻³. With volume deposits a reflected wavefront's straight
+// step is not retaken where it meets an interface (cpu_simulator.cpp stepPatch). BENCHMARKS.md,
+// issue 13 nineteenth part.
 constexpr double kReflectedStepFactor = 4.0;
 // DepthLimit::Keep keeps a patch at max_depth unsplit only while its longest edge is at most this
 // many split lengths; beyond it the patch is killed (its midpoint no longer says where its flux
