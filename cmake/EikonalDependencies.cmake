@@ -18,6 +18,9 @@ pkg_check_modules(IMGUI REQUIRED IMPORTED_TARGET imgui>=1.86)
 pkg_check_modules(OPENEXR REQUIRED IMPORTED_TARGET OpenEXR>=3)
 pkg_check_modules(PNG REQUIRED IMPORTED_TARGET libpng16)
 pkg_check_modules(STB REQUIRED IMPORTED_TARGET stb)
+# NRRD gzip data (core/gzip_stream.cpp): libdeflate reads whole streams many times faster than
+# zlib's streaming inflate; zlib stays for the parallel writer and for the reader's diagnoses.
+pkg_check_modules(LIBDEFLATE REQUIRED IMPORTED_TARGET libdeflate)
 # The programs' allocator (core/allocator.cpp): jemalloc with transparent huge pages. Not with the
 # sanitizers or the fuzzers, whose own allocator must see every allocation.
 if(EIKONAL_SANITIZE OR EIKONAL_FUZZ)

@@ -1,10 +1,13 @@
 #include "core/gzip_stream.h"
 
+#include <libdeflate.h>
+#include <sys/stat.h>
 #include <zlib.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <memory>
 #include <vector>
 
 #include "core/error.h"
@@ -29,10 +32,48 @@ struct DeflateStream {
   }
 };
 
+struct DecompressorDeleter {
+  void operator()(libdeflate_decompressor* d) const { libdeflate_free_decompressor(d); }
+};
+
+// The fast path: the rest of `file` read whole and decompressed by libdeflate, member after member,
+// several times faster than zlib's streaming inflate (the 128³ sphere's interfaces field, 37 MB
+// from 1.5 MB: 8 ms against 0.2 s). True only where the stream is gzip, fills `out` exactly and
+// ends with the file; anywhere else (a byte skip, a zlib stream, a pipe, an error of any kind) the
+// file is put back where it was and false returned, so that the streaming reader below reads it
+// and says precisely what is wrong.
+bool readWholeGzip(std::FILE* file, std::span<std::byte> out) {
+  const long start = std::ftell(file);
+  struct stat info {};
+  if (start < 0 || fstat(fileno(file), &info) != 0 || !S_ISREG(info.st_mode) || info.st_size <= start) return false;
+  std::vector<unsigned char> input(static_cast<std::size_t>(info.st_size - start));
+  const std::size_t got = std::fread(input.data(), 1, input.size(), file);
+  const std::unique_ptr<libdeflate_decompressor, DecompressorDeleter> decompressor(libdeflate_alloc_decompressor());
+  bool whole = got == input.size() && got >= 2 && input[0] == 0x1f && input[1] == 0x8b && decompressor != nullptr;
+  std::size_t used = 0, filled = 0;
+  while (whole && used < input.size()) {
+    std::size_t member_in = 0, member_out = 0;
+    whole = libdeflate_gzip_decompress_ex(decompressor.get(), input.data() + used, input.size() - used,
+                                          out.data() + filled, out.size() - filled, &member_in,
+                                          &member_out) == LIBDEFLATE_SUCCESS &&
+            member_in > 0;
+    used += member_in;
+    filled += member_out;
+  }
+  if (whole && filled == out.size()) return true;
+  std::clearerr(file);
+  std::fseek(file, start, SEEK_SET);
+  return false;
+}
+
 }  // namespace
 
 GzipReadResult readGzipStream(std::FILE* file, std::span<std::byte> out, std::uint64_t skip) {
   GzipReadResult result;
+  if (skip == 0 && readWholeGzip(file, out)) {
+    result.filled = out.size();
+    return result;
+  }
   InflateStream stream;
   if (inflateInit2(&stream.z, 15 + 32) != Z_OK) {
     result.status = GzipReadStatus::InitFailed;
@@ -152,7 +193,8 @@ void writeGzipStream(std::span<const unsigned char> bytes, const GzipSink& write
         output.resize(output.size() * 2);  // not reached with deflateBound's size; kept for safety
       }
       output.resize(produced);
-      crcs[static_cast<std::size_t>(k)] = crc32(0, bytes.data() + begin, static_cast<uInt>(length));
+      // libdeflate's CRC-32 (the same checksum, carry-less multiplication: several times zlib's speed).
+      crcs[static_cast<std::size_t>(k)] = libdeflate_crc32(0, bytes.data() + begin, length);
     });
     for (std::size_t k = 0; k < count; ++k) {
       const std::size_t length = std::min(kBlock, bytes.size() - (first + k) * kBlock);

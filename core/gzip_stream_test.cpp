@@ -28,12 +28,28 @@ std::string compressed(const std::string& bytes) {
   return out;
 }
 
-// Reads `stream` into a buffer of `size` bytes after skipping `skip`.
+GzipReadResult readFrom(std::FILE* file, std::size_t size, std::string& buffer, std::uint64_t skip) {
+  buffer.assign(size, '\0');
+  return readGzipStream(file, std::as_writable_bytes(std::span<char>(buffer)), skip);
+}
+
+// Reads `stream` into a buffer of `size` bytes after skipping `skip`, twice: from memory (a stream
+// without a file descriptor: zlib's streaming reader alone) and from a temporary file (libdeflate's
+// whole-stream path first, falling back to the streaming reader on anything unusual). Both must
+// end the same way with the same bytes, whichever path took the file.
 GzipReadResult read(const std::string& stream, std::size_t size, std::string* out = nullptr, std::uint64_t skip = 0) {
-  FilePtr file(fmemopen(const_cast<char*>(stream.data()), stream.size(), "rb"));
-  std::string buffer(size, '\0');
-  GzipReadResult result = readGzipStream(file.get(), std::as_writable_bytes(std::span<char>(buffer)), skip);
-  if (out) *out = buffer;
+  FilePtr memory(fmemopen(const_cast<char*>(stream.data()), stream.size(), "rb"));
+  std::string streamed, whole;
+  const GzipReadResult result = readFrom(memory.get(), size, streamed, skip);
+  FilePtr file(std::tmpfile());
+  EXPECT_EQ(std::fwrite(stream.data(), 1, stream.size(), file.get()), stream.size());
+  std::rewind(file.get());
+  const GzipReadResult from_file = readFrom(file.get(), size, whole, skip);
+  EXPECT_EQ(from_file.status, result.status);
+  EXPECT_EQ(from_file.filled, result.filled);
+  EXPECT_EQ(from_file.surplus, result.surplus);
+  EXPECT_EQ(whole.substr(0, from_file.filled), streamed.substr(0, result.filled));
+  if (out) *out = streamed;
   return result;
 }
 
@@ -87,6 +103,32 @@ TEST(GzipStream, SkipsAndFollowsConcatenatedMembers) {
   EXPECT_EQ(back, (a + b).substr(100));
   EXPECT_EQ(read(stream, 10, nullptr, a.size() + b.size()).status, GzipReadStatus::Truncated);
   EXPECT_EQ(read(stream, 0, nullptr, a.size() + b.size() + 1).status, GzipReadStatus::SkipNotReached);
+  // Without a skip (libdeflate's path from a file): both members, then an empty third one.
+  EXPECT_EQ(read(stream + compressed(""), a.size() + b.size(), &back).status, GzipReadStatus::Complete);
+  EXPECT_EQ(back, a + b);
+}
+
+// A file read from where its header ended (as readNrrd hands it over), and the fast path's
+// refusal puts it back there for the streaming reader.
+TEST(GzipStream, ReadsFromTheFilesPositionAndFallsBackFromThere) {
+  const std::string bytes = randomBytes(6000);
+  const std::string header = "NRRD0004\nencoding: gzip\n\n";
+  for (const bool corrupt : {false, true}) {
+    std::string stream = compressed(bytes);
+    if (corrupt) stream[stream.size() / 2] = static_cast<char>(stream[stream.size() / 2] ^ 0x55);
+    FilePtr file(std::tmpfile());
+    const std::string contents = header + stream;
+    ASSERT_EQ(std::fwrite(contents.data(), 1, contents.size(), file.get()), contents.size());
+    ASSERT_EQ(std::fseek(file.get(), static_cast<long>(header.size()), SEEK_SET), 0);
+    std::string back;
+    const GzipReadResult result = readFrom(file.get(), bytes.size(), back, 0);
+    if (!corrupt) {
+      EXPECT_EQ(result.status, GzipReadStatus::Complete);
+      EXPECT_EQ(back, bytes);
+    } else {
+      EXPECT_NE(result.status, GzipReadStatus::Complete) << "a damaged stream is not read as whole";
+    }
+  }
 }
 
 TEST(GzipStream, EveryWayToBeWrong) {
