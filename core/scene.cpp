@@ -9,6 +9,8 @@
 #include <set>
 #include <sstream>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/paths.h"
@@ -117,6 +119,14 @@ std::filesystem::path Scene::resolve(const std::string& key, const std::string& 
   if (!file.empty()) return resolveInsideFolder(file, key, named);
   std::filesystem::path p(named);
   return p.is_absolute() ? p : base_dir / p;
+}
+
+glm::dmat4 objectToWorld(const SceneObjectSpec& o) {
+  glm::dmat4 m = glm::translate(glm::dmat4(1.0), o.translate);
+  m = glm::rotate(m, glm::radians(o.rotate_deg.z), glm::dvec3(0, 0, 1));
+  m = glm::rotate(m, glm::radians(o.rotate_deg.y), glm::dvec3(0, 1, 0));
+  m = glm::rotate(m, glm::radians(o.rotate_deg.x), glm::dvec3(1, 0, 0));
+  return glm::scale(m, glm::dvec3(o.scale));
 }
 
 Scene sceneFromJson(const json& j, const std::string& source) {

@@ -73,6 +73,10 @@ struct Scene {
   std::filesystem::path resolve(const std::string& key, const std::string& named) const;
 };
 
+// Where an object's volume lies in the world: translate · Rz · Ry · Rx · scale (docs/scene-format.md
+// "Placement of an object").
+glm::dmat4 objectToWorld(const SceneObjectSpec& object);
+
 // Parses and validates; `source` names the file in messages ("scene.json: lights[0].direction: ...").
 Scene sceneFromJson(const nlohmann::json& j, const std::string& source);
 Scene readScene(const std::filesystem::path& file);

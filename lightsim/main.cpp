@@ -7,8 +7,11 @@
 // command line, runs the simulator through its interface, reports progress and writes the outputs.
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,11 +21,14 @@
 #include "core/cli.h"
 #include "core/error.h"
 #include "core/interfaces.h"
+#include "core/json_input.h"
 #include "core/progress.h"
+#include "core/scene.h"
 #include "core/stopwatch.h"
 #include "core/volume.h"
 #include "lightsim/bake.h"
 #include "lightsim/make_simulator.h"
+#include "lightsim/scene_bake.h"
 #include "lightsim/wavefront.h"
 
 namespace fs = std::filesystem;
@@ -33,11 +39,29 @@ namespace {
 // "cpu, 2 threads, SIMD AVX3" or the GL renderer's name.
 std::string rendererName(const SimulationStats& s) { return s.renderer + (s.simd.empty() ? "" : ", SIMD " + s.simd); }
 
+// Whether `path` is a SCENE.json (a JSON object with "objects") rather than a volume's manifest.
+// Anything that does not parse is left to the volume's reader, which says what is wrong with it.
+bool isSceneFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  std::string text;
+  constexpr std::size_t kMaxSceneBytes = std::size_t{16} << 20;  // scenes and manifests are kilobytes
+  text.resize(kMaxSceneBytes + 1);
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxSceneBytes) return false;
+  try {
+    const nlohmann::json j = parseJsonInput(text, path);
+    return j.is_object() && j.contains("objects");
+  } catch (const InputError&) {
+    return false;
+  }
+}
+
 int run(int argc, char** argv) {
   std::string input, output, light_text, power_text = "1,1,1", scene_path, backend = "auto", deposit = "accumulate",
                                          integrator = "euler", split_rule = "axis", at_max_depth = "keep", stats_path,
-                                         gl_backend = "auto", kernel = "track", receiver_text,
-                                         count_readback = "auto";
+                                         gl_backend = "auto", kernel = "track", receiver_text, count_readback = "auto";
   bool no_receiver = false;
   SimulationOptions options;
   double options_receiver_pitch = 0.25;
@@ -48,9 +72,14 @@ int run(int argc, char** argv) {
       "lightsim: propagate a light's wavefront through a volume as a GPU particle system of adaptive\n"
       "patches and bake irradiance and light direction into it (thesis §4, §6.2).",
       "lightsim"};
-  app.add_option("input", input, "the volume to bake, IN.vol.json (needs ior and ior_grad; sigma_a if absorbing)")
+  app.add_option("input", input,
+                 "the volume to bake, IN.vol.json (needs ior and ior_grad; sigma_a if absorbing), or a SCENE.json "
+                 "whose objects are baked each under its placement (its first light, its ground)")
       ->required();
-  app.add_option("-o,--output", output, "the baked volume, OUT.vol.json (IN plus irradiance and light_dir)")->required();
+  app.add_option("-o,--output", output,
+                 "the baked volume, OUT.vol.json (IN plus irradiance and light_dir); for a SCENE.json a folder "
+                 "that gets each object's baked volume and a SCENE.json naming them")
+      ->required();
   app.add_option("--light", light_text, "directional:DX,DY,DZ (direction of travel) or point:X,Y,Z");
   app.add_option("--power", power_text,
                  "R,G,B: irradiance in W/m² of a directional light, radiant intensity in W/sr of a point light "
@@ -104,10 +133,9 @@ int run(int argc, char** argv) {
       ->check(CLI::IsMember({"euler", "rk2", "rk4"}));
   app.add_option("--step", options.step_voxels, "time step: arc length per step in air, in voxels (default 0.5)")
       ->check(CLI::Range(0.01, 4.0));
-  CLI::Option* patch =
-      app.add_option("--patch", options.patch_voxels,
-                     "initial patch edge in voxels (default half the split length, at least 1)")
-          ->check(CLI::Range(0.05, 8.0));
+  CLI::Option* patch = app.add_option("--patch", options.patch_voxels,
+                                      "initial patch edge in voxels (default half the split length, at least 1)")
+                           ->check(CLI::Range(0.05, 8.0));
   CLI::Option* split =
       app.add_option("--split", options.split_voxels,
                      "split patches with an edge longer than this, in voxels (default with sharp interfaces: the "
@@ -130,7 +158,8 @@ int run(int argc, char** argv) {
                  "sigma in voxels of a Gaussian reconstruction filter on the baked irradiance: it removes "
                  "the voxel-scale grain of midpoint deposits, at the cost of that much blur (default 0: none)")
       ->check(CLI::Range(0.0, 4.0));
-  app.add_option("--max-steps", options.max_steps, "step limit (default: 4 grid diagonals)")->check(CLI::Range(0, 1000000));
+  app.add_option("--max-steps", options.max_steps, "step limit (default: 4 grid diagonals)")
+      ->check(CLI::Range(0, 1000000));
   app.add_option("--flux-threshold", options.flux_threshold,
                  "kill patches below this fraction of the initial patch flux (default 1e-4)")
       ->check(CLI::Range(0.0, 1.0));
@@ -152,10 +181,197 @@ int run(int argc, char** argv) {
       "  lightsim sphere.vol.json -o sphere.baked.vol.json --light directional:0,-1,0 --power 1,1,1\n"
       "  lightsim glass.vol.json -o glass.baked.vol.json --scene glass.scene.json --backend cpu\n"
       "  lightsim sphere.vol.json -o sphere.baked.vol.json --light directional:0,-1,0 --receiver 0,0,0:0,1,0\n"
+      "  lightsim museum/SCENE.json -o museum-baked\n"
       "Exit codes: 0 success, 1 runtime failure, 2 bad usage or bad input.");
   addOutsidePathsFlag(app);
   if (!parseCommandLine(app, argc, argv)) return kExitOk;
 
+  options.deposit = deposit == "max" ? DepositMode::Max : DepositMode::Accumulate;
+  options.split_rule = split_rule == "quad" ? SplitRule::Quad : SplitRule::Axis;
+  options.at_max_depth = at_max_depth == "kill" ? DepthLimit::Kill : DepthLimit::Keep;
+  options.integrator = integrator == "rk4"   ? Integrator::RK4
+                       : integrator == "rk2" ? Integrator::RK2
+                                             : Integrator::Euler;
+  options.deposit_kernel = kernel == "point" ? DepositKernel::Point : DepositKernel::Track;
+  options.free_flight = free_flight == "on";
+  // Bakes `volume` (read from `source`) with `light` and writes it to `out` (and the stats to
+  // `stats_file`): the whole of a volume's bake, and one object's of a scene's. `scale` is the
+  // object's (scene_bake.h); light and receiver are given in its bake frame.
+  auto bake = [&](Volume& volume, const std::string& source, const LightSpec& light, SimulationOptions options,
+                  const std::string& out, const std::string& stats_file, double scale) {
+    const std::string& output = out;
+    const std::string& stats_path = stats_file;
+    const VolumeDefaults defaults = volumeDefaults(volume.has("interfaces"), volume.grid);
+    if (max_depth->count() == 0) options.max_depth = defaults.max_depth;
+    if (patch->count() == 0) options.patch_voxels = defaults.patch_voxels;
+    if (split->count() == 0) options.split_voxels = defaults.split_voxels;
+    options.volume_deposits = volume_deposits == "on" || (volume_deposits == "auto" &&
+                                                          viewerReadsVolumeLight(volume, options.receiver.has_value()));
+    if (!options.volume_deposits && !options.receiver)
+      throw InputError("command line", "--volume-deposits",
+                       "off needs a receiver (--receiver or a --scene with a ground): "
+                       "the bake would make nothing");
+    if (volume_deposits == "auto" && !options.volume_deposits && !quiet)
+      std::fprintf(stderr,
+                   "lightsim: --volume-deposits auto: nothing in the volume scatters or is opaque and the "
+                   "receiver gets a map, so only the map is baked (no irradiance/light_dir fields)\n");
+
+    SimulatorBackendOptions choice;
+    choice.backend = backend == "cpu"    ? SimulatorBackend::Cpu
+                     : backend == "auto" ? SimulatorBackend::Auto
+                                         : SimulatorBackend::Gl;
+    choice.gl = gl_backend;
+    choice.count_readback = count_readback == "wait"      ? GpuSimulatorOptions::CountReadback::Wait
+                            : count_readback == "overlap" ? GpuSimulatorOptions::CountReadback::Overlap
+                                                          : GpuSimulatorOptions::CountReadback::Auto;
+    choice.source = source;
+    if (!quiet)
+      choice.report = [](const std::string& why) {
+        std::fprintf(stderr, "lightsim: --backend auto: %s\n", why.c_str());
+      };
+    // The bake runs in the object's bake frame (scene_bake.h): the volume at world scale.
+    const std::optional<Volume> scaled =
+        scale != 1.0 ? std::optional<Volume>(volumeAtWorldScale(volume, scale)) : std::nullopt;
+    const std::unique_ptr<Simulator> simulator = makeSimulator(scaled ? *scaled : volume, choice, &options);
+    ProgressBar bar("lightsim", !quiet && bench_runs == 0);
+    options.progress = bar.callback();
+    BakeResult result;
+    std::vector<double> seconds;
+    for (int run = 0; run < std::max(1, bench_runs); ++run) {
+      const Stopwatch watch;
+      result = simulator->run(light, options);
+      seconds.push_back(watch.seconds());
+      if (bench_runs > 0 && !quiet)
+        std::fprintf(stderr, "lightsim: bench run %d of %d: %.3f s\n", run + 1, bench_runs, seconds.back());
+    }
+    bar.finish();
+    nlohmann::json stats_json = result.stats.toJson();
+    stats_json.update(simulator->lastRunStats());
+    if (bench_runs > 0) {
+      std::vector<double> sorted = seconds;
+      std::sort(sorted.begin(), sorted.end());
+      const double median = sorted.size() % 2 ? sorted[sorted.size() / 2]
+                                              : 0.5 * (sorted[sorted.size() / 2 - 1] + sorted[sorted.size() / 2]);
+      const double rate = static_cast<double>(result.stats.total_patches) / median;
+      stats_json["bench"] = {{"runs", bench_runs},
+                             {"seconds", seconds},
+                             {"median_s", median},
+                             {"patch_steps_per_s", rate},
+                             {"grid", {volume.grid.dims.x, volume.grid.dims.y, volume.grid.dims.z}}};
+      std::printf(
+          "lightsim bench: %dx%dx%d, %s: median %.3f s of %d runs (min %.3f, max %.3f); %llu patch-steps, "
+          "%.3g patch-steps/s; peak %llu patches",
+          volume.grid.dims.x, volume.grid.dims.y, volume.grid.dims.z, rendererName(result.stats).c_str(), median,
+          bench_runs, sorted.front(), sorted.back(), static_cast<unsigned long long>(result.stats.total_patches), rate,
+          static_cast<unsigned long long>(result.stats.peak_patches));
+      if (stats_json.contains("texture_bytes"))
+        std::printf("; %.1f MiB of textures at the peak",
+                    static_cast<double>(stats_json["texture_bytes"]["total_peak"].get<std::size_t>()) / (1 << 20));
+      std::printf("\n");
+    }
+    if (lightMissedVolume(result.stats))
+      std::fprintf(stderr, "lightsim: warning: the light misses the volume; the bake is empty\n");
+
+    if (smooth_irradiance > 0.0) smoothIrradiance(result, volume.grid, smooth_irradiance);
+    LightSpec baked_light = light;
+    bakeToVolumeFrame(result, baked_light, scale);
+    applyBake(volume, result, baked_light);
+    volume.metadata["bake_options"] = bakeOptionsToJson(options);
+    if (smooth_irradiance > 0.0) volume.metadata["irradiance_smoothing_sigma_voxels"] = smooth_irradiance;
+    VolumeWriteOptions write;
+    write.gzip = !raw;
+    // The input's fields are written back as they were read (their encoded samples copied), all but
+    // the two a bake makes.
+    write.unchanged_fields = volume.field_files;
+    write.unchanged_fields.erase("irradiance");
+    write.unchanged_fields.erase("light_dir");
+    writeVolume(volume, output, write);
+    if (!stats_path.empty()) writeFileAtomic(stats_path, stats_json.dump(2) + "\n");
+    if (!quiet) {
+      const SimulationStats& s = result.stats;
+      std::fprintf(stderr, "lightsim: %d steps, %llu initial / %llu peak patches, %llu splits on %s\n", s.steps,
+                   static_cast<unsigned long long>(s.initial_patches), static_cast<unsigned long long>(s.peak_patches),
+                   static_cast<unsigned long long>(s.splits), rendererName(s).c_str());
+      for (const ReceiverMap& map : result.receivers)
+        std::fprintf(stderr, "lightsim: receiver '%s': %d x %d texels of %.4g, %.4g W of %.4g W received\n",
+                     map.name.c_str(), map.texels.x, map.texels.y, map.pitch, luminance(s.flux_received),
+                     luminance(s.flux_in));
+      std::fprintf(stderr, "lightsim: wrote %s\n", output.c_str());
+    }
+    return kExitOk;
+  };
+
+  if (isSceneFile(input)) {
+    for (const auto& [given, flag] : {std::pair{!light_text.empty(), "--light"},
+                                      {power_text != "1,1,1", "--power"},
+                                      {!scene_path.empty(), "--scene"},
+                                      {!receiver_text.empty(), "--receiver"},
+                                      {no_receiver, "--no-receiver"},
+                                      {!stats_path.empty(), "--stats"},
+                                      {bench_runs > 0, "--bench"}})
+      if (given)
+        throw InputError("command line", flag,
+                         std::string("not with a SCENE.json input: the scene gives the light and the ground, and each "
+                                     "baked manifest holds its bake's stats"));
+    const Scene scene = readScene(input);
+    const fs::path out_dir = fs::absolute(output);
+    if (!fs::is_directory(out_dir.parent_path()))
+      throw InputError("-o", output, "directory " + out_dir.parent_path().string() + " does not exist");
+    if (fs::exists(out_dir) && !fs::is_directory(out_dir))
+      throw InputError("-o", output, "with a SCENE.json input -o names a folder, and this is a file");
+    if (fs::exists(out_dir / "SCENE.json") && fs::equivalent(out_dir / "SCENE.json", fs::path(input)))
+      throw InputError("-o", output, "the baked SCENE.json would overwrite the input scene: choose another folder");
+    const LightSpec world_light = lightFromScene(input);
+    if (scene.lights.size() > 1 && !quiet)
+      std::fprintf(stderr, "lightsim: warning: %s has %zu lights; only the first is baked\n", input.c_str(),
+                   scene.lights.size());
+    std::optional<ReceiverSpec> ground = receiverFromScene(input);
+    if (ground) ground->pitch_voxels = options_receiver_pitch;
+    // Every object's volume is read and checked before anything is baked or written.
+    std::vector<Volume> volumes;
+    std::vector<std::string> sources, names;
+    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+      const std::string key = "objects[" + std::to_string(i) + "].volume";
+      const fs::path path = scene.resolve(key, scene.objects[i].volume);
+      volumes.push_back(readVolume(path));
+      sources.push_back(path.string());
+      volumes.back().require("ior", 1, sources.back());
+      volumes.back().require("ior_grad", 3, sources.back());
+      interfaceTable(volumes.back(), sources.back());
+      std::string stem = path.filename().string();
+      for (const char* suffix : {".vol.json", ".json"})
+        if (stem.size() > std::strlen(suffix) && stem.ends_with(suffix)) {
+          stem.resize(stem.size() - std::strlen(suffix));
+          break;
+        }
+      if (stem.ends_with(".baked")) stem.resize(stem.size() - 6);
+      std::string name = stem + ".baked.vol.json";
+      for (int k = 2; std::find(names.begin(), names.end(), name) != names.end(); ++k)
+        name = stem + "-" + std::to_string(k) + ".baked.vol.json";
+      names.push_back(name);
+    }
+    fs::create_directories(out_dir);
+    Scene baked = scene;
+    for (std::size_t i = 0; i < volumes.size(); ++i) {
+      const BakeFrame frame = BakeFrame::of(scene.objects[i]);
+      SimulationOptions object_options = options;
+      if (ground) object_options.receiver = frame.receiver(*ground);
+      if (!quiet) std::fprintf(stderr, "lightsim: [%zu/%zu] %s\n", i + 1, volumes.size(), sources[i].c_str());
+      bake(volumes[i], sources[i], frame.light(world_light), object_options, (out_dir / names[i]).string(), "",
+           frame.scale);
+      volumes[i] = Volume();  // its memory for the next object's bake
+      baked.objects[i].volume = names[i];
+    }
+    if (!scene.environment.file.empty()) {
+      const fs::path from = scene.resolve("environment.file", scene.environment.file);
+      const fs::path to = out_dir / from.filename();
+      if (!fs::exists(to) || !fs::equivalent(from, to)) fs::copy_file(from, to, fs::copy_options::overwrite_existing);
+      baked.environment.file = from.filename().string();
+    }
+    writeScene(baked, out_dir / "SCENE.json");
+    if (!quiet) std::fprintf(stderr, "lightsim: wrote %s\n", (out_dir / "SCENE.json").string().c_str());
+    return kExitOk;
+  }
   if (output.size() < 9 || output.substr(output.size() - 9) != ".vol.json")
     throw InputError("-o", output, "the output manifest must end in .vol.json");
   for (const std::string* path : {&output, &stats_path}) {
@@ -166,12 +382,6 @@ int run(int argc, char** argv) {
   if (light_text.empty() == scene_path.empty())
     throw InputError("command line", "--light", "give either --light (with --power) or --scene");
   const LightSpec light = scene_path.empty() ? parseLight(light_text, power_text) : lightFromScene(scene_path);
-  options.deposit = deposit == "max" ? DepositMode::Max : DepositMode::Accumulate;
-  options.split_rule = split_rule == "quad" ? SplitRule::Quad : SplitRule::Axis;
-  options.at_max_depth = at_max_depth == "kill" ? DepthLimit::Kill : DepthLimit::Keep;
-  options.integrator = integrator == "rk4" ? Integrator::RK4 : integrator == "rk2" ? Integrator::RK2 : Integrator::Euler;
-  options.deposit_kernel = kernel == "point" ? DepositKernel::Point : DepositKernel::Track;
-  options.free_flight = free_flight == "on";
   if (!receiver_text.empty() && no_receiver)
     throw InputError("command line", "--no-receiver", "give --receiver or --no-receiver, not both");
   if (!receiver_text.empty()) {
@@ -180,97 +390,11 @@ int run(int argc, char** argv) {
     options.receiver = receiverFromScene(scene_path);
   }
   if (options.receiver) options.receiver->pitch_voxels = options_receiver_pitch;
-
   Volume volume = readVolume(input);
   volume.require("ior", 1, input);
   volume.require("ior_grad", 3, input);
   interfaceTable(volume, input);  // a malformed table is named with the file, before any work
-  const VolumeDefaults defaults = volumeDefaults(volume.has("interfaces"), volume.grid);
-  if (max_depth->count() == 0) options.max_depth = defaults.max_depth;
-  if (patch->count() == 0) options.patch_voxels = defaults.patch_voxels;
-  if (split->count() == 0) options.split_voxels = defaults.split_voxels;
-  options.volume_deposits = volume_deposits == "on" ||
-                            (volume_deposits == "auto" && viewerReadsVolumeLight(volume, options.receiver.has_value()));
-  if (!options.volume_deposits && !options.receiver)
-    throw InputError("command line", "--volume-deposits", "off needs a receiver (--receiver or a --scene with a ground): "
-                                                          "the bake would make nothing");
-  if (volume_deposits == "auto" && !options.volume_deposits && !quiet)
-    std::fprintf(stderr, "lightsim: --volume-deposits auto: nothing in the volume scatters or is opaque and the "
-                         "receiver gets a map, so only the map is baked (no irradiance/light_dir fields)\n");
-
-  SimulatorBackendOptions choice;
-  choice.backend = backend == "cpu"    ? SimulatorBackend::Cpu
-                   : backend == "auto" ? SimulatorBackend::Auto
-                                       : SimulatorBackend::Gl;
-  choice.gl = gl_backend;
-  choice.count_readback = count_readback == "wait"      ? GpuSimulatorOptions::CountReadback::Wait
-                          : count_readback == "overlap" ? GpuSimulatorOptions::CountReadback::Overlap
-                                                        : GpuSimulatorOptions::CountReadback::Auto;
-  choice.source = input;
-  if (!quiet)
-    choice.report = [](const std::string& why) { std::fprintf(stderr, "lightsim: --backend auto: %s\n", why.c_str()); };
-  const std::unique_ptr<Simulator> simulator = makeSimulator(volume, choice, &options);
-  ProgressBar bar("lightsim", !quiet && bench_runs == 0);
-  options.progress = bar.callback();
-  BakeResult result;
-  std::vector<double> seconds;
-  for (int run = 0; run < std::max(1, bench_runs); ++run) {
-    const Stopwatch watch;
-    result = simulator->run(light, options);
-    seconds.push_back(watch.seconds());
-    if (bench_runs > 0 && !quiet)
-      std::fprintf(stderr, "lightsim: bench run %d of %d: %.3f s\n", run + 1, bench_runs, seconds.back());
-  }
-  bar.finish();
-  nlohmann::json stats_json = result.stats.toJson();
-  stats_json.update(simulator->lastRunStats());
-  if (bench_runs > 0) {
-    std::vector<double> sorted = seconds;
-    std::sort(sorted.begin(), sorted.end());
-    const double median = sorted.size() % 2 ? sorted[sorted.size() / 2]
-                                             : 0.5 * (sorted[sorted.size() / 2 - 1] + sorted[sorted.size() / 2]);
-    const double rate = static_cast<double>(result.stats.total_patches) / median;
-    stats_json["bench"] = {{"runs", bench_runs},        {"seconds", seconds},
-                           {"median_s", median},        {"patch_steps_per_s", rate},
-                           {"grid", {volume.grid.dims.x, volume.grid.dims.y, volume.grid.dims.z}}};
-    std::printf("lightsim bench: %dx%dx%d, %s: median %.3f s of %d runs (min %.3f, max %.3f); %llu patch-steps, "
-                "%.3g patch-steps/s; peak %llu patches",
-                volume.grid.dims.x, volume.grid.dims.y, volume.grid.dims.z, rendererName(result.stats).c_str(), median,
-                bench_runs, sorted.front(), sorted.back(), static_cast<unsigned long long>(result.stats.total_patches),
-                rate, static_cast<unsigned long long>(result.stats.peak_patches));
-    if (stats_json.contains("texture_bytes"))
-      std::printf("; %.1f MiB of textures at the peak",
-                  static_cast<double>(stats_json["texture_bytes"]["total_peak"].get<std::size_t>()) / (1 << 20));
-    std::printf("\n");
-  }
-  if (lightMissedVolume(result.stats))
-    std::fprintf(stderr, "lightsim: warning: the light misses the volume; the bake is empty\n");
-
-  if (smooth_irradiance > 0.0) smoothIrradiance(result, volume.grid, smooth_irradiance);
-  applyBake(volume, result, light);
-  volume.metadata["bake_options"] = bakeOptionsToJson(options);
-  if (smooth_irradiance > 0.0) volume.metadata["irradiance_smoothing_sigma_voxels"] = smooth_irradiance;
-  VolumeWriteOptions write;
-  write.gzip = !raw;
-  // The input's fields are written back as they were read (their encoded samples copied), all but
-  // the two a bake makes.
-  write.unchanged_fields = volume.field_files;
-  write.unchanged_fields.erase("irradiance");
-  write.unchanged_fields.erase("light_dir");
-  writeVolume(volume, output, write);
-  if (!stats_path.empty()) writeFileAtomic(stats_path, stats_json.dump(2) + "\n");
-  if (!quiet) {
-    const SimulationStats& s = result.stats;
-    std::fprintf(stderr, "lightsim: %d steps, %llu initial / %llu peak patches, %llu splits on %s\n", s.steps,
-                 static_cast<unsigned long long>(s.initial_patches), static_cast<unsigned long long>(s.peak_patches),
-                 static_cast<unsigned long long>(s.splits), rendererName(s).c_str());
-    for (const ReceiverMap& map : result.receivers)
-      std::fprintf(stderr, "lightsim: receiver '%s': %d x %d texels of %.4g, %.4g W of %.4g W received\n",
-                   map.name.c_str(), map.texels.x, map.texels.y, map.pitch, luminance(s.flux_received),
-                   luminance(s.flux_in));
-    std::fprintf(stderr, "lightsim: wrote %s\n", output.c_str());
-  }
-  return kExitOk;
+  return bake(volume, input, light, options, output, stats_path, 1.0);
 }
 
 }  // namespace

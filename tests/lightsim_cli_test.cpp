@@ -254,6 +254,61 @@ TEST(LightsimCli, BadInputExitsTwo) {
   }
 }
 
+// `lightsim SCENE.json -o OUT_DIR`: every object baked under its placement, into the folder with a
+// SCENE.json naming the baked volumes that the viewer opens as it is. The same volume placed twice
+// gets two baked volumes; the turned one records the sun as its own axes see it.
+TEST(LightsimCli, BakesAWholeSceneIntoAFolderTheViewerOpens) {
+  TempDir dir;
+  makeSphere(dir, true);
+  writeFile(dir / "SCENE.json", R"({
+    "camera": {"eye": [0, 1.5, 3], "target": [0, 0, 0]},
+    "environment": {"uniform": [0.1, 0.1, 0.1]},
+    "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": [2, 2, 2]}],
+    "ground": {"point": [0, -0.6, 0], "normal": [0, 1, 0], "half_extent": 2},
+    "objects": [{"volume": "sharp.vol.json", "translate": [-0.6, 0, 0]},
+                {"volume": "sharp.vol.json", "translate": [0.6, 0, 0], "rotate_deg": [0, 0, 30], "scale": 0.8}]})");
+  ProgramResult r = runProgram(LIGHTSIM_EXE, {"SCENE.json", "-o", "baked", "--quiet"}, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json scene = nlohmann::json::parse(readFile(dir / "baked" / "SCENE.json"));
+  ASSERT_EQ(scene["objects"].size(), 2u);
+  EXPECT_EQ(scene["objects"][0]["volume"], "sharp.baked.vol.json");
+  EXPECT_EQ(scene["objects"][1]["volume"], "sharp-2.baked.vol.json");
+  EXPECT_EQ(scene["objects"][1]["scale"], 0.8);
+  const Volume upright = readVolume(dir / "baked" / "sharp.baked.vol.json");
+  const Volume turned = readVolume(dir / "baked" / "sharp-2.baked.vol.json");
+  ASSERT_EQ(upright.receivers.size(), 1u);
+  ASSERT_EQ(turned.receivers.size(), 1u);
+  // Rz(30°)⁻¹ · (0, −1, 0) = (−sin 30°, −cos 30°, 0): the sun as the turned volume sees it.
+  const nlohmann::json& d = turned.metadata["light"]["direction"];
+  EXPECT_NEAR(d[0].get<double>(), -0.5, 1e-9);
+  EXPECT_NEAR(d[1].get<double>(), -std::sqrt(3.0) / 2.0, 1e-9);
+  EXPECT_EQ(upright.metadata["light"]["direction"][1], -1.0);
+  // The ground y = −0.6 in the turned volume's axes (world = T + R·s·p): the normal Rᵀ·(0, 1, 0) =
+  // (sin 30°, cos 30°, 0), the plane n·p = −0.6 / 0.8 (T lies in the plane y = 0).
+  const ReceiverMap& map = turned.receivers[0];
+  EXPECT_NEAR(map.normal.x, 0.5, 1e-9);
+  EXPECT_NEAR(map.normal.y, std::sqrt(3.0) / 2.0, 1e-9);
+  EXPECT_NEAR(glm::dot(map.point, map.normal), -0.75, 1e-9);
+  ProgramResult v = runProgram(VIEWER_EXE, {"baked/SCENE.json", "--render", "scene.png", "--size", "48x32"}, dir.path());
+  EXPECT_EQ(v.exit_code, 0) << v.output;
+  // A scene input takes no light, receiver, stats or bench of its own, -o names a folder, and a
+  // missing object's volume stops the bake before anything is written.
+  writeFile(dir / "missing.json", R"({"lights": [{"type": "directional", "direction": [0, -1, 0]}],
+    "objects": [{"volume": "sharp.vol.json"}, {"volume": "nowhere.vol.json"}]})");
+  writeFile(dir / "afile", "x");
+  for (const auto& [args, expected] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"SCENE.json", "-o", "x", "--light", "directional:0,-1,0"}, "--light"},
+           {{"SCENE.json", "-o", "x", "--stats", "s.json"}, "--stats"},
+           {{"SCENE.json", "-o", "afile"}, "folder"},
+           {{"SCENE.json", "-o", "."}, "overwrite the input scene"},
+           {{"missing.json", "-o", "x"}, "nowhere.vol.json"}}) {
+    ProgramResult bad = runProgram(LIGHTSIM_EXE, args, dir.path());
+    EXPECT_EQ(bad.exit_code, 2) << bad.output;
+    EXPECT_NE(bad.output.find(expected), std::string::npos) << "expected '" << expected << "' in: " << bad.output;
+    EXPECT_FALSE(std::filesystem::exists(dir / "x")) << bad.output;
+  }
+}
+
 // Ctrl-C (SIGINT) or a kill (SIGTERM) during a bake: exit 130 / 143, a message, and no output file
 // or temporary left (core/interrupt.h). The bake repeats (--bench); the signal is sent once the first
 // repetition has reported, so it finds the program at work whatever the machine's load.

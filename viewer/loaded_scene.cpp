@@ -53,14 +53,6 @@ std::vector<SceneLightSpec> bakedLights(const Volume& volume) {
 
 }  // namespace
 
-glm::dmat4 objectToWorld(const SceneObjectSpec& o) {
-  glm::dmat4 m = glm::translate(glm::dmat4(1.0), o.translate);
-  m = glm::rotate(m, glm::radians(o.rotate_deg.z), glm::dvec3(0, 0, 1));
-  m = glm::rotate(m, glm::radians(o.rotate_deg.y), glm::dvec3(0, 1, 0));
-  m = glm::rotate(m, glm::radians(o.rotate_deg.x), glm::dvec3(1, 0, 0));
-  return glm::scale(m, glm::dvec3(o.scale));
-}
-
 SceneCameraSpec framingCamera(const GridSpec& grid, double fov_y_deg) {
   SceneCameraSpec camera;
   const glm::dvec3 center = 0.5 * (grid.bounds_min + grid.bounds_max);

@@ -30,8 +30,6 @@ struct LoadedScene {
   Camera camera() const { return Camera::fromSpec(scene.camera); }
 };
 
-// The object's placement: translate · Rz · Ry · Rx · scale (docs/scene-format.md).
-glm::dmat4 objectToWorld(const SceneObjectSpec& object);
 
 // A camera looking at the box from the front and a little above, the whole box in view.
 SceneCameraSpec framingCamera(const GridSpec& grid, double fov_y_deg = 40.0);

@@ -280,6 +280,8 @@ struct SceneRenderer::Impl {
         p.set("uObjRecvLightPower" + i, o.receiver_light_power);
       }
       p.set("uObjBrickSize" + i, glm::vec3(o.grid.extent() / glm::dvec3(o.grid.dims) * double(kBrickVoxels)));
+      // The placement's uniform scale (docs/scene-format.md): a volume unit is this many world units.
+      p.set("uObjLengthScale" + i, static_cast<float>(std::cbrt(std::abs(glm::determinant(glm::dmat3(o.to_world))))));
     }
 
     // Lights: the first directional one follows setLightDirection.

@@ -468,6 +468,28 @@ Volume filledBlock(glm::dvec3 half, int res, double n, glm::dvec3 sigma_a) {
   return v;
 }
 
+// A placed object's σa is per world unit (docs/scene-format.md "Placement of an object"): the slab
+// above scaled by 2 is 2 thick in the world and lets exp(−2σa) through, as the bake at world scale
+// (lightsim/scene_bake.h) assumes; the volume's own unit would let exp(−σa) through.
+TEST_F(SceneRendererTest, AScaledObjectAbsorbsOverItsWorldThickness) {
+  const glm::dvec3 sigma_a(0.0, 0.5, 1.0);
+  SceneObjectSpec twice;
+  twice.scale = 2.0;
+  RenderSettings no_fresnel;
+  no_fresnel.fresnel = false;
+  const Image smoothed = render(oneObject(smoothedVolume(slab(0.5), 1.5, sigma_a, 48), "uniform:1,1,1", twice),
+                                lookAt({0, 0, 6}, {0, 0, 0}, 10.0), {33, 33}, no_fresnel);
+  // The sharp block takes the homogeneous bricks' long steps (skipHomogeneousBrick) through its
+  // constant σa.
+  const Image sharp = render(oneObject(filledBlock({1.0, 1.0, 0.5}, 32, 1.5, sigma_a), "uniform:1,1,1", twice),
+                             lookAt({0, 0, 6}, {0, 0, 0}, 10.0), {9, 9}, no_fresnel);
+  for (int c = 0; c < 3; ++c) {
+    const double expected = std::exp(-2.0 * sigma_a[c]);
+    EXPECT_NEAR(smoothed.at(16, 16)[c], expected, 0.01 * expected) << "smoothed slab, channel " << c;
+    EXPECT_NEAR(sharp.at(4, 4)[c], expected, 0.01 * expected) << "sharp block, channel " << c;
+  }
+}
+
 TEST_F(SceneRendererTest, MaterialTouchingItsBoxRefractsAtTheFaces) {
   // Beer–Lambert through a filled block of thickness 1 at normal incidence: as with a smoothed slab.
   const glm::dvec3 sigma_a(0.0, 0.5, 1.0);

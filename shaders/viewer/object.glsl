@@ -369,9 +369,9 @@ bool skipHomogeneousBrick@(inout March@ m, vec3 uvw) {
     float L = min(min(toFace.x, toFace.y), toFace.z) + 0.01 * m.h;
     if (!m.inLayer) rememberStateBeforeLayer@(m, length(m.w), dir);  // a quiet stretch
 #if defined(ATTENUATION) && defined(HAS_SIGMA_A) && defined(MEDIUM_SIGMA_A)
-    m.tau += MEDIUM_SIGMA_A(m.medium) * L;  // Beer–Lambert, σa constant here
+    m.tau += MEDIUM_SIGMA_A(m.medium) * (L * uObjLengthScale[@]);  // Beer–Lambert, σa constant here
 #elif defined(ATTENUATION) && defined(HAS_SIGMA_A)
-    m.tau += volumeSigmaA(uvw) * L;
+    m.tau += volumeSigmaA(uvw) * (L * uObjLengthScale[@]);
 #endif
     m.xStepStart = m.x;  // a step like any other for the events after it (the ground, a sharp face)
     m.x += dir * L;
@@ -516,9 +516,10 @@ float stepLength@(March@ m, vec3 uvw, float grad2) {
 // uvw, the step's middle (the midpoint rule; it runs after the step, once the step is known not
 // to cross a sharp surface, or from crossInterface@ up to the surface).
 void gatherMedium@(inout Ray r, inout March@ m, vec3 uvw, float hs) {
-  absorb@(m, uvw, hs);
-  emit@(r, m, uvw, hs);
-  inScatter@(r, m, uvw, hs);
+  float ds = hs * uObjLengthScale[@];  // the step in world units: σa, L_e and the baked light are per world unit
+  absorb@(m, uvw, ds);
+  emit@(r, m, uvw, ds);
+  inScatter@(r, m, uvw, ds);
 }
 
 // One step of the ray equation in arc length (Eq. 5.11/5.12, the discrete Eq. 4.8/4.9):

@@ -33,6 +33,7 @@ uniform float uObjStep[OBJECT_COUNT];        // arc length per step, volume unit
 uniform int uObjMaxSteps[OBJECT_COUNT];
 uniform float uObjBoundaryGrad[OBJECT_COUNT];  // |∇n| above which the ray is in a boundary layer
 uniform vec3 uObjBrickSize[OBJECT_COUNT];    // a homogeneity brick's extent, volume units
+uniform float uObjLengthScale[OBJECT_COUNT];  // world units per volume unit: the object's scale (σa, L_e per world unit)
 // The object's receiver map of the ground (HAS_RECEIVER; core/receiver_map.h), volume space: the
 // plane's point and in-plane axes, the map's corner (u, v) and extent, and the light it was baked
 // with (w = 0: direction it travels, w = 1: position; its irradiance or intensity).
