@@ -257,15 +257,21 @@ TEST(Receiver, TheDirectLightIsWhatTheLeftOutCellsWouldPutOnTheMap) {
   for (const Patch& p : followed) in_followed += p.flux;
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(in_followed[c] + direct.flux[c], in_all[c], 1e-12 * in_all[c]);
 
-  // A point light keeps every cell a patch.
+  // A point light leaves its cells that miss the box to the closed form as well (I·cos θ/d² a
+  // texel: ExactOpticsFreeAir.APointLightFallsOffByTheInverseSquareLaw), and only a light that
+  // reaches the plane's front has one.
   LightSpec point;
   point.type = LightSpec::Type::Point;
   point.position = {0.2, 1.5, 0.1};
   const ReceiverMap point_map = receiverGeometry(spec, point, volume.grid, lo, hi);
-  DirectCells none;
-  initialPatches(point, volume.grid, sampler, options, nullptr, &point_map, &none);
-  EXPECT_EQ(none.cells, 0u);
-  EXPECT_THROW(directMapLight(point_map, point, {}), InputError);
+  DirectCells left;
+  const std::vector<Patch> point_followed = initialPatches(point, volume.grid, sampler, options, nullptr, &point_map, &left);
+  EXPECT_GT(left.cells, 0u);
+  EXPECT_GT(point_followed.size(), 0u);
+  EXPECT_EQ(directMapLight(point_map, point, point_followed).size(), point_map.texelCount());
+  LightSpec below = point;
+  below.position.y = spec.point.y - 1.0;
+  EXPECT_THROW(directMapLight(point_map, below, {}), InputError);
 }
 
 TEST(Receiver, TheMapCoversTheShadowAndOneShadowSizeAround) {

@@ -603,7 +603,8 @@ std::vector<Patch> directionalPatches(const LightSpec& light, const GridSpec& gr
 }
 
 std::vector<Patch> pointPatches(const LightSpec& light, const GridSpec& grid, const VolumeSampler& sampler,
-                                const SimulationOptions& options, const ReceiverMap* map) {
+                                const SimulationOptions& options, const ReceiverMap* map, DirectCells* direct,
+                                double* flux_ref) {
   glm::dvec3 lo, hi;
   propagationBox(grid, options, lo, hi);
   const glm::dvec3 p = light.position;
@@ -612,6 +613,10 @@ std::vector<Patch> pointPatches(const LightSpec& light, const GridSpec& grid, co
   const auto& faces = cubeFaces();
   auto param = [m](int i) { return -1.0 + 2.0 * (static_cast<double>(i) / m); };
 
+  // The cells that go straight to the map, when they are left to directMapLight, per row.
+  const bool leave_direct = direct != nullptr && map != nullptr;
+  std::vector<DirectCells> row_direct(leave_direct ? static_cast<std::size_t>(6 * m) : 0);
+  std::vector<double> row_ref(static_cast<std::size_t>(6 * m), 0.0);
   std::vector<std::vector<Patch>> rows(static_cast<std::size_t>(6 * m));
   parallelFor(0, 6 * static_cast<std::int64_t>(m), [&](std::int64_t row_index) {
     const CubeFace& face = faces[static_cast<std::size_t>(row_index / m)];
@@ -622,7 +627,17 @@ std::vector<Patch> pointPatches(const LightSpec& light, const GridSpec& grid, co
     for (int i = 0; i < m; ++i) {
       const double a0 = param(i), a1 = param(i + 1);
       const glm::dvec3 centre = dirAt(0.5 * (a0 + a1), 0.5 * (b0 + b1));
-      if (!rayHitsBox(p, centre, lo, hi) && !rayHitsMap(p, centre, map, options.patch_voxels * voxelEdge(grid))) continue;
+      const bool box = rayHitsBox(p, centre, lo, hi);
+      if (!box && !rayHitsMap(p, centre, map, options.patch_voxels * voxelEdge(grid))) continue;
+      if (!box && leave_direct) {
+        const glm::dvec3 flux = light.power * cubeCellSolidAngle(a0, b0, a1, b1);  // Φ = I·Ω_cell
+        DirectCells& d = row_direct[static_cast<std::size_t>(row_index)];
+        ++d.cells;
+        d.flux += flux;
+        double& ref = row_ref[static_cast<std::size_t>(row_index)];
+        ref = std::max(ref, std::max(flux.x, std::max(flux.y, flux.z)));
+        continue;
+      }
       const glm::dvec3 dirs[4] = {dirAt(a0, b0), dirAt(a1, b0), dirAt(a1, b1), dirAt(a0, b1)};
       Patch patch;
       for (int c = 0; c < 4; ++c) {
@@ -637,6 +652,12 @@ std::vector<Patch> pointPatches(const LightSpec& light, const GridSpec& grid, co
   });
   std::vector<Patch> patches;
   for (auto& row : rows) patches.insert(patches.end(), row.begin(), row.end());
+  for (const DirectCells& d : row_direct) {
+    direct->cells += d.cells;
+    direct->flux += d.flux;
+  }
+  if (flux_ref)
+    for (const double ref : row_ref) *flux_ref = std::max(*flux_ref, ref);
   return patches;
 }
 
@@ -674,7 +695,7 @@ std::vector<Patch> initialPatches(const LightSpec& light, const GridSpec& grid, 
   std::vector<Patch> patches =
       light.type == LightSpec::Type::Directional
           ? directionalPatches(light, grid, sampler, options, map, options.direct_receiver_light ? direct : nullptr, &ref)
-          : pointPatches(light, grid, sampler, options, map);
+          : pointPatches(light, grid, sampler, options, map, options.direct_receiver_light ? direct : nullptr, &ref);
   if (flux_ref) {
     for (const Patch& patch : patches) ref = std::max(ref, std::max(patch.flux.x, std::max(patch.flux.y, patch.flux.z)));
     *flux_ref = ref;
