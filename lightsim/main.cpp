@@ -314,7 +314,7 @@ int run(int argc, char** argv) {
                          std::string("not with a SCENE.json input: the scene gives the light and the ground, and each "
                                      "baked manifest holds its bake's stats"));
     const Scene scene = readScene(input);
-    const fs::path out_dir = fs::absolute(output);
+    const fs::path out_dir = fs::absolute(output).lexically_normal();
     if (!fs::is_directory(out_dir.parent_path()))
       throw InputError("-o", output, "directory " + out_dir.parent_path().string() + " does not exist");
     if (fs::exists(out_dir) && !fs::is_directory(out_dir))

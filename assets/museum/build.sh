@@ -9,6 +9,7 @@ voxelize procedural:logo_block,size=0.6:0.6:0.3,center=0:-0.2:0 -o logo_block.vo
          --bounds -0.35,-0.53,-0.55,0.5,0.12,0.2
 voxelize procedural:layered_cube,size=0.5,center=0:-0.25:0,scatter=1,g=0.3 -o layered_cube.vol.json \
          --res "$(res 56)" --bounds -0.3,-0.53,-0.55,0.45,0.02,0.3
-for object in wine_glass sphere logo_block layered_cube; do
-  lightsim "$object.vol.json" -o "$object.baked.vol.json"
-done
+# One command bakes them all, each as SCENE.json places it (lightsim SCENE.json -o DIR): the scene
+# with the volumes before their bake goes in, the baked volumes and SCENE.json come out here.
+sed 's/\.baked\.vol\.json/.vol.json/' SCENE.json >bake.json
+timed bake "$bin/lightsim/lightsim" bake.json -o . --backend "$backend" $quiet
