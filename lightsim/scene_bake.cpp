@@ -1,17 +1,19 @@
 #include "lightsim/scene_bake.h"
 
+#include <cmath>
+
 #include "core/interfaces.h"
 
 namespace eik {
 
-BakeFrame BakeFrame::of(const SceneObjectSpec& object) {
-  SceneObjectSpec unscaled = object;
-  unscaled.scale = 1.0;
-  const glm::dmat4 m = objectToWorld(unscaled);
+BakeFrame BakeFrame::of(const SceneObjectSpec& object) { return of(objectToWorld(object)); }
+
+BakeFrame BakeFrame::of(const glm::dmat4& object_to_world) {
+  const glm::dmat3 linear(object_to_world);
   BakeFrame frame;
-  frame.rotation = glm::dmat3(m);
-  frame.origin = glm::dvec3(m[3]);
-  frame.scale = object.scale;
+  frame.scale = std::cbrt(std::abs(glm::determinant(linear)));
+  frame.rotation = linear / frame.scale;
+  frame.origin = glm::dvec3(object_to_world[3]);
   return frame;
 }
 

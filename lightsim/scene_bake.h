@@ -25,6 +25,8 @@ struct BakeFrame {
   double scale = 1.0;        // the object's uniform scale s
 
   static BakeFrame of(const SceneObjectSpec& object);
+  // From a placement matrix translate · rotation · uniform scale (objectToWorld's).
+  static BakeFrame of(const glm::dmat4& object_to_world);
   // A light or a receiver plane given in the world, in the bake frame.
   LightSpec light(const LightSpec& world) const;
   ReceiverSpec receiver(const ReceiverSpec& world) const;

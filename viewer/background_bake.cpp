@@ -51,17 +51,25 @@ std::vector<RebakeSource> rebakeSources(const LoadedScene& scene) {
     defaults.max_depth = volume_defaults.max_depth;
     defaults.patch_voxels = volume_defaults.patch_voxels;
     defaults.split_voxels = volume_defaults.split_voxels;
+    // The bake runs in the object's bake frame, as `lightsim SCENE.json` bakes it: the scene's ground
+    // carried into the volume's axes, lengths at world scale.
+    s.frame = BakeFrame::of(object.object_to_world);
     if (scene.scene.ground) {
-      const glm::dmat4 to_volume = glm::inverse(object.object_to_world);
       ReceiverSpec ground;
-      ground.point = glm::dvec3(to_volume * glm::dvec4(scene.scene.ground->point, 1.0));
-      ground.normal = glm::normalize(glm::transpose(glm::dmat3(object.object_to_world)) * scene.scene.ground->normal);
+      ground.point = scene.scene.ground->point;
+      ground.normal = glm::normalize(scene.scene.ground->normal);
       ground.half_extent = scene.scene.ground->half_extent;
-      defaults.receiver = ground;
+      defaults.receiver = s.frame.receiver(ground);
     }
     s.options = volume.metadata.contains("bake_options")
                     ? bakeOptionsFromJson(volume.metadata.at("bake_options"), object.source, defaults)
                     : defaults;
+    // The plane is the scene's, wherever the manifest's bake had it (a bake of `lightsim VOLUME
+    // --scene` records it in the volume's coordinates, unplaced).
+    if (s.options.receiver && defaults.receiver) {
+      s.options.receiver->point = defaults.receiver->point;
+      s.options.receiver->normal = defaults.receiver->normal;
+    }
     const nlohmann::json sigma = volume.metadata.value("irradiance_smoothing_sigma_voxels", nlohmann::json(0.0));
     s.smoothing_sigma = sigma.is_number() && std::isfinite(sigma.get<double>()) ? std::max(0.0, sigma.get<double>()) : 0.0;
 
@@ -69,6 +77,7 @@ std::vector<RebakeSource> rebakeSources(const LoadedScene& scene) {
     material->fields.erase("irradiance");
     material->fields.erase("light_dir");
     material->receivers.clear();
+    s.bake_material = s.frame.scale == 1.0 ? material : std::make_shared<Volume>(volumeAtWorldScale(*material, s.frame.scale));
     s.material = std::move(material);
     sources.push_back(std::move(s));
   }
@@ -88,15 +97,16 @@ namespace {
 LoadedObject rebakeWith(Simulator& simulator, const RebakeSource& source, glm::dvec3 world_direction,
                         BakeQuality quality, const std::atomic<bool>* cancel, ProgressFn progress,
                         SimulationStats* stats) {
-  LightSpec light = source.light;
-  const glm::dvec3 local = glm::inverse(glm::dmat3(source.object_to_world)) * world_direction;
-  const double length = glm::length(local);
+  const double length = glm::length(world_direction);
   if (!(length > 0.0) || !std::isfinite(length)) throw std::invalid_argument("rebake: the light direction is zero");
-  light.direction = local / length;
+  LightSpec world = source.light;
+  world.direction = world_direction / length;
+  LightSpec light = source.frame.light(world);
   SimulationOptions options = quality == BakeQuality::Coarse ? coarseOptions(source.options) : source.options;
   options.cancel = cancel;
   options.progress = std::move(progress);
   BakeResult result = simulator.run(light, options);
+  bakeToVolumeFrame(result, light, source.frame.scale);
   if (source.smoothing_sigma > 0.0) smoothIrradiance(result, source.material->grid, source.smoothing_sigma);
   LoadedObject object;
   object.source = source.source;
@@ -112,7 +122,7 @@ LoadedObject rebakeWith(Simulator& simulator, const RebakeSource& source, glm::d
 
 LoadedObject rebake(const RebakeSource& source, glm::dvec3 world_direction, BakeQuality quality,
                     const std::atomic<bool>* cancel, ProgressFn progress) {
-  CpuSimulator simulator(*source.material);
+  CpuSimulator simulator(*source.bake_material);
   return rebakeWith(simulator, source, world_direction, quality, cancel, std::move(progress), nullptr);
 }
 
@@ -187,7 +197,7 @@ void BackgroundBake::work() {
     for (std::size_t i = 0; i < sources_.size(); ++i) {
       const RebakeSource& source = sources_[i];
       try {
-        if (!simulators[i]) simulators[i] = std::make_unique<CpuSimulator>(*source.material);
+        if (!simulators[i]) simulators[i] = std::make_unique<CpuSimulator>(*source.bake_material);
         const Stopwatch watch;
         Landed landed;
         const double done = static_cast<double>(i) * share;

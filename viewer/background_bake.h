@@ -22,6 +22,7 @@
 
 #include <glm/glm.hpp>
 
+#include "lightsim/scene_bake.h"
 #include "lightsim/simulator.h"
 #include "viewer/loaded_scene.h"
 
@@ -34,7 +35,11 @@ struct RebakeSource {
   int object = 0;                  // index in LoadedScene::objects
   std::string source;              // the manifest's path, for messages
   std::shared_ptr<const Volume> material;  // the volume less irradiance, light_dir and receivers
+  // What the simulator bakes: `material` at world scale (lightsim/scene_bake.h), the same volume
+  // where the object is not scaled.
+  std::shared_ptr<const Volume> bake_material;
   glm::dmat4 object_to_world{1.0};
+  BakeFrame frame;                 // the object's bake frame: the scene's light and ground in its axes
   LightSpec light;                 // as baked: directional, its irradiance
   SimulationOptions options;       // "bake_options", or lightsim's defaults for this volume
   double smoothing_sigma = 0.0;    // "irradiance_smoothing_sigma_voxels"

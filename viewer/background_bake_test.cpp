@@ -96,6 +96,46 @@ TEST(BackgroundBake, ARebakeIsTheBakeLightsimMakesWithTheNewLight) {
   EXPECT_NE(rebaked.volume.fields.at("irradiance").data, scene.objects[0].volume.fields.at("irradiance").data);
 }
 
+// A scaled object is re-baked as `lightsim SCENE.json` bakes it: at world scale, its σa per world
+// unit. An absorbing glass slab 0.3 thick (wider than its volume), placed with scale 2, under the sun
+// straight down: the floor under it gets E·(1 − R)²·exp(−σa·0.6), R = 0.04 at each face (the light
+// reflected twice inside, R²·e^(−2τ) ≈ 10⁻³ of it, is not followed at one bounce); baked in the
+// volume's own unit it would get exp(−σa·0.3), 35 % more.
+TEST(BackgroundBake, AScaledObjectIsRebakedAtWorldScale) {
+  const auto b = test_scenes::box({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5});
+  Volume slab = test_scenes::sharpVolume("procedural:box,size=4:0.3:4,center=0:0:0,ior=1.5,sigma_a=1:1:1", 32, b);
+  slab.metadata["light"] = directional({0.0, -1.0, 0.0}).toJson();
+  slab.receivers.push_back(ReceiverMap{});  // as a baked volume has: the window re-bakes it
+  Scene scene;
+  SceneObjectSpec placed;
+  placed.scale = 2.0;
+  placed.translate = {0.3, 0.0, -0.2};
+  scene.objects.push_back(placed);
+  SceneGroundSpec ground;
+  ground.point = {0.0, -1.2, 0.0};  // the volume's y = −0.6, below its box
+  ground.half_extent = 1.5;
+  scene.ground = ground;
+  const LoadedScene loaded = sceneFromVolumes(scene, {slab});
+  const std::vector<RebakeSource> sources = rebakeSources(loaded);
+  ASSERT_EQ(sources.size(), 1u);
+  EXPECT_EQ(sources[0].frame.scale, 2.0);
+  const LoadedObject rebaked = rebake(sources[0], {0.0, -1.0, 0.0}, BakeQuality::Full);
+  ASSERT_EQ(rebaked.volume.receivers.size(), 1u);
+  const ReceiverMap& map = rebaked.volume.receivers[0];
+  // The map in the volume's coordinates: its plane at y = −0.6, the world's −1.2 over the scale.
+  EXPECT_NEAR(glm::dot(map.point, map.normal), -0.6, 1e-9);
+  // The texel under the slab's middle (the volume's origin, well inside its 4-wide faces).
+  const glm::dvec2 uv = map.planeCoordinates(glm::dvec3(0.0, -0.6, 0.0)) - map.origin;
+  const int i = static_cast<int>(uv.x / map.pitch), j = static_cast<int>(uv.y / map.pitch);
+  const double got = map.irradiance[3 * (static_cast<std::size_t>(j) * map.texels.x + i)];
+  const double want = (1.0 - 0.04) * (1.0 - 0.04) * std::exp(-1.0 * 0.6);
+  std::printf("scaled slab: the floor under it %.5f, exact %.5f (in the volume's unit %.5f)\n", got, want,
+              want * std::exp(0.3));
+  // 1 %: the followed reflection's share, 10⁻³, and the map's texel at the slab's middle, where the
+  // light comes straight through; the volume's unit is off by 35 %.
+  EXPECT_NEAR(got / want, 1.0, 0.01);
+}
+
 // At two resolutions (32³ and 48³), each against the exact tracer.
 TEST(BackgroundBake, TheCausticMovesToWhereExactOpticsPutsIt) {
   for (int res : {kBallRes, 48}) {
