@@ -165,7 +165,9 @@ Scene sceneFromJson(const json& j, const std::string& source) {
     if (!lights.is_array()) top.fail("lights", "expected an array");
     for (std::size_t i = 0; i < lights.size(); ++i) {
       std::string path = "lights[" + std::to_string(i) + "]";
-      ObjectReader r(lights[i], source, path, {"type", "direction", "irradiance", "position", "intensity", "name"});
+      ObjectReader r(lights[i], source, path,
+                     {"type", "direction", "irradiance", "position", "intensity", "inner_cone_deg", "outer_cone_deg",
+                      "name"});
       SceneLightSpec light;
       std::string type = r.string("type", "");
       if (type == "directional") {
@@ -183,9 +185,27 @@ Scene sceneFromJson(const json& j, const std::string& source) {
         requireNonNegative(r, "intensity", light.intensity);
         requireLightPower(r, "intensity", light.intensity);
         if (r.has("direction") || r.has("irradiance")) r.fail(path, "a point light takes position and intensity");
+      } else if (type == "spot") {
+        light.type = SceneLightSpec::Type::Spot;
+        if (!r.has("position")) r.fail(path + ".position", "missing");
+        if (!r.has("direction")) r.fail(path + ".direction", "missing");
+        light.position = r.vec3("position", light.position);
+        light.direction = requireUnit(r, "direction", r.vec3("direction", light.direction));
+        light.intensity = r.vec3("intensity", light.intensity);
+        requireNonNegative(r, "intensity", light.intensity);
+        requireLightPower(r, "intensity", light.intensity);
+        light.inner_cone_deg = r.number("inner_cone_deg", light.inner_cone_deg);
+        light.outer_cone_deg = r.number("outer_cone_deg", light.outer_cone_deg);
+        if (!(light.outer_cone_deg > 0.0 && light.outer_cone_deg <= 90.0))
+          r.fail(path + ".outer_cone_deg", "must be in (0, 90]");
+        if (!(light.inner_cone_deg >= 0.0 && light.inner_cone_deg < light.outer_cone_deg))
+          r.fail(path + ".inner_cone_deg", "must be in [0, outer_cone_deg)");
+        if (r.has("irradiance")) r.fail(path, "a spot light takes position, direction, intensity and its cone");
       } else {
-        r.fail(path + ".type", "expected \"directional\" or \"point\", got \"" + type + "\"");
+        r.fail(path + ".type", "expected \"directional\", \"point\" or \"spot\", got \"" + type + "\"");
       }
+      if (light.type != SceneLightSpec::Type::Spot && (r.has("inner_cone_deg") || r.has("outer_cone_deg")))
+        r.fail(path, "only a spot light has a cone");
       scene.lights.push_back(light);
     }
   }
@@ -271,8 +291,15 @@ json sceneToJson(const Scene& s) {
   for (const auto& l : s.lights) {
     if (l.type == SceneLightSpec::Type::Directional)
       j["lights"].push_back({{"type", "directional"}, {"direction", toJson(l.direction)}, {"irradiance", toJson(l.irradiance)}});
-    else
+    else if (l.type == SceneLightSpec::Type::Point)
       j["lights"].push_back({{"type", "point"}, {"position", toJson(l.position)}, {"intensity", toJson(l.intensity)}});
+    else
+      j["lights"].push_back({{"type", "spot"},
+                             {"position", toJson(l.position)},
+                             {"direction", toJson(l.direction)},
+                             {"intensity", toJson(l.intensity)},
+                             {"inner_cone_deg", l.inner_cone_deg},
+                             {"outer_cone_deg", l.outer_cone_deg}});
   }
   if (s.ground)
     j["ground"] = {{"point", toJson(s.ground->point)},

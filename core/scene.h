@@ -2,6 +2,8 @@
 // settings (docs/scene-format.md). Read strictly: wrong types and unknown keys are InputErrors (exit 2).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -20,13 +22,37 @@ struct SceneCameraSpec {
 };
 
 struct SceneLightSpec {
-  enum class Type { Directional, Point };
+  enum class Type { Directional, Point, Spot };
   Type type = Type::Directional;
-  glm::dvec3 direction{0.0, -1.0, 0.0};   // directional: direction the light travels (unit)
+  glm::dvec3 direction{0.0, -1.0, 0.0};   // directional: direction the light travels; spot: its axis (unit)
   glm::dvec3 irradiance{1.0};             // directional: W/m² on a plane facing the light, RGB
-  glm::dvec3 position{0.0};               // point
-  glm::dvec3 intensity{1.0};              // point: radiant intensity W/sr, RGB
+  glm::dvec3 position{0.0};               // point, spot
+  glm::dvec3 intensity{1.0};              // point, spot (on its axis): radiant intensity W/sr, RGB
+  double inner_cone_deg = 0.0;            // spot: full intensity within this angle of the axis
+  double outer_cone_deg = 45.0;           // spot: none beyond it (glTF KHR_lights_punctual's defaults)
 };
+
+// A spot light's intensity off its axis, as a fraction of the axis' (glTF KHR_lights_punctual):
+// ((cos θ − cos θ_outer)/(cos θ_inner − cos θ_outer))² clamped to [0, 1], θ the angle between the
+// axis and the direction the light leaves in (the difference of the cosines at least 10⁻³).
+inline double spotAttenuation(double cos_theta, double cos_inner, double cos_outer) {
+  const double t = (cos_theta - cos_outer) / std::max(1e-3, cos_inner - cos_outer);
+  const double c = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+  return c * c;
+}
+
+// The same cone as the viewer's shaders take it: (axis, cos θ_outer) and 1/(cos θ_inner − cos θ_outer)
+// (at most 10³), the attenuation then clamp((axis·d − cos θ_outer)·scale, 0, 1)².
+struct SpotCone {
+  glm::dvec4 axis_cos_outer{0.0};
+  double scale = 0.0;
+};
+inline SpotCone spotCone(const glm::dvec3& axis, double inner_cone_deg, double outer_cone_deg) {
+  const double cos_inner = std::cos(inner_cone_deg * 3.14159265358979323846 / 180.0);
+  const double cos_outer = std::cos(outer_cone_deg * 3.14159265358979323846 / 180.0);
+  const double len = std::sqrt(axis.x * axis.x + axis.y * axis.y + axis.z * axis.z);
+  return {glm::dvec4(len > 0.0 ? axis / len : axis, cos_outer), 1.0 / std::max(1e-3, cos_inner - cos_outer)};
+}
 
 struct SceneEnvironmentSpec {
   std::optional<glm::dvec3> uniform = glm::dvec3(0.1);   // uniform radiance, or

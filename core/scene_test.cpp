@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <numbers>
+
 #include "core/error.h"
 
 namespace eik {
@@ -59,7 +62,23 @@ TEST(Scene, RejectsWrongTypes) {
   EXPECT_NE(errorOf(R"({"camera": {"eye": "up there"}})").find("camera.eye"), std::string::npos);
   EXPECT_NE(errorOf(R"({"lights": [{"type": "directional", "direction": [0, 1]}]})").find("lights[0].direction"),
             std::string::npos);
-  EXPECT_NE(errorOf(R"({"lights": [{"type": "spot"}]})").find("lights[0].type"), std::string::npos);
+  EXPECT_NE(errorOf(R"({"lights": [{"type": "area"}]})").find("lights[0].type"), std::string::npos);
+  // A spot light needs its position and axis, and a cone 0 ≤ inner < outer ≤ 90°; only it has one.
+  EXPECT_NE(errorOf(R"({"lights": [{"type": "spot", "direction": [0, -1, 0]}]})").find("lights[0].position"),
+            std::string::npos);
+  EXPECT_NE(errorOf(R"({"lights": [{"type": "spot", "position": [0, 1, 0]}]})").find("lights[0].direction"),
+            std::string::npos);
+  EXPECT_NE(errorOf(R"({"lights": [{"type": "spot", "position": [0, 1, 0], "direction": [0, -1, 0],
+                                    "outer_cone_deg": 95}]})")
+                .find("lights[0].outer_cone_deg"),
+            std::string::npos);
+  EXPECT_NE(errorOf(R"({"lights": [{"type": "spot", "position": [0, 1, 0], "direction": [0, -1, 0],
+                                    "inner_cone_deg": 30, "outer_cone_deg": 20}]})")
+                .find("lights[0].inner_cone_deg"),
+            std::string::npos);
+  EXPECT_NE(errorOf(R"({"lights": [{"type": "point", "position": [0, 1, 0], "outer_cone_deg": 20}]})")
+                .find("only a spot light has a cone"),
+            std::string::npos);
   EXPECT_NE(errorOf(R"({"render": {"size": [0, 10]}})").find("render.size"), std::string::npos);
   EXPECT_NE(errorOf(R"({"render": {"tonemap": "filmic"}})").find("render.tonemap"), std::string::npos);
   // Integers beyond int are refused, not wrapped (4294967312 became 16); the step as viewer --step.
@@ -89,6 +108,28 @@ TEST(Scene, EnvironmentKindsAreExclusive) {
   Scene s = sceneFromJson(json::parse(R"({"environment": {"file": "sky.exr", "intensity": 2}})"), "s.json");
   EXPECT_EQ(s.environment.file, "sky.exr");
   EXPECT_FALSE(s.environment.uniform.has_value());
+}
+
+// A spot light (glTF KHR_lights_punctual's cone) reads and writes back as it was; its attenuation is
+// 1 within the inner cone, 0 beyond the outer one, and ((cos θ − cos θo)/(cos θi − cos θo))² between.
+TEST(Scene, ASpotLightRoundTripsWithItsCone) {
+  const Scene scene = sceneFromJson(nlohmann::json::parse(R"({"lights": [{"type": "spot", "position": [0, 2, 0],
+      "direction": [0, -1, 0], "intensity": [3, 3, 3], "inner_cone_deg": 20, "outer_cone_deg": 30}]})"),
+                                    "test");
+  ASSERT_EQ(scene.lights.size(), 1u);
+  const SceneLightSpec& l = scene.lights[0];
+  EXPECT_EQ(l.type, SceneLightSpec::Type::Spot);
+  EXPECT_EQ(l.inner_cone_deg, 20.0);
+  EXPECT_EQ(l.outer_cone_deg, 30.0);
+  const Scene back = sceneFromJson(sceneToJson(scene), "back");
+  EXPECT_EQ(back.lights.at(0).type, SceneLightSpec::Type::Spot);
+  EXPECT_EQ(back.lights.at(0).outer_cone_deg, 30.0);
+  EXPECT_EQ(back.lights.at(0).direction, l.direction);
+  const double ci = std::cos(20.0 * std::numbers::pi / 180.0), co = std::cos(30.0 * std::numbers::pi / 180.0);
+  EXPECT_EQ(spotAttenuation(std::cos(10.0 * std::numbers::pi / 180.0), ci, co), 1.0);
+  EXPECT_EQ(spotAttenuation(std::cos(31.0 * std::numbers::pi / 180.0), ci, co), 0.0);
+  const double mid = std::cos(25.0 * std::numbers::pi / 180.0);
+  EXPECT_NEAR(spotAttenuation(mid, ci, co), ((mid - co) / (ci - co)) * ((mid - co) / (ci - co)), 1e-15);
 }
 
 }  // namespace

@@ -45,7 +45,20 @@ std::vector<double> parseNumbers(const std::string& text, const std::string& sou
 nlohmann::json LightSpec::toJson() const {
   if (type == Type::Directional)
     return {{"type", "directional"}, {"direction", vec3Json(direction)}, {"irradiance", vec3Json(power)}};
+  if (type == Type::Spot)
+    return {{"type", "spot"},
+            {"position", vec3Json(position)},
+            {"direction", vec3Json(direction)},
+            {"intensity", vec3Json(power)},
+            {"inner_cone_deg", inner_cone_deg},
+            {"outer_cone_deg", outer_cone_deg}};
   return {{"type", "point"}, {"position", vec3Json(position)}, {"intensity", vec3Json(power)}};
+}
+
+double LightSpec::attenuation(const glm::dvec3& dir) const {
+  if (type != Type::Spot) return 1.0;
+  return spotAttenuation(glm::dot(glm::normalize(direction), dir), std::cos(glm::radians(inner_cone_deg)),
+                         std::cos(glm::radians(outer_cone_deg)));
 }
 
 double SimulationStats::ledgerResidual() const {
@@ -292,9 +305,12 @@ LightSpec lightFromScene(const std::filesystem::path& file) {
     light.direction = l.direction;
     light.power = l.irradiance;
   } else {
-    light.type = LightSpec::Type::Point;
+    light.type = l.type == SceneLightSpec::Type::Spot ? LightSpec::Type::Spot : LightSpec::Type::Point;
     light.position = l.position;
     light.power = l.intensity;
+    light.direction = l.direction;
+    light.inner_cone_deg = l.inner_cone_deg;
+    light.outer_cone_deg = l.outer_cone_deg;
   }
   if (!(light.power.x > 0 || light.power.y > 0 || light.power.z > 0))
     throw InputError(file.string(), "lights[0]", "the light has no power");

@@ -181,7 +181,7 @@ void depositConvex(const ReceiverMap& map, const glm::dvec2* polygon, int count,
 
 std::vector<glm::dvec3> directMapLight(const ReceiverMap& map, const LightSpec& light,
                                        const std::vector<Patch>& followed) {
-  const bool point = light.type == LightSpec::Type::Point;
+  const bool point = light.type != LightSpec::Type::Directional;  // a point or a spot light
   const glm::dvec3 L = point ? glm::dvec3(0.0) : glm::normalize(light.direction);
   // |L·n| for a directional light that reaches the front; a point light's height over the plane.
   const double facing = point ? glm::dot(light.position - map.point, map.normal) : -glm::dot(L, map.normal);
@@ -227,8 +227,9 @@ std::vector<glm::dvec3> directMapLight(const ReceiverMap& map, const LightSpec& 
           return;
         }
         const int i = static_cast<int>(t % map.texels.x), j = static_cast<int>(t / map.texels.x);
-        const double d = glm::length(map.texelCenter(i, j) - light.position);
-        f = glm::max(full / (d * d * d) - f, glm::dvec3(0.0));
+        const glm::dvec3 to_texel = map.texelCenter(i, j) - light.position;
+        const double d = glm::length(to_texel);
+        f = glm::max(full * (light.attenuation(to_texel / d) / (d * d * d)) - f, glm::dvec3(0.0));
       },
       4096);
   return flux;

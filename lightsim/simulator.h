@@ -24,14 +24,18 @@
 namespace eik {
 
 struct LightSpec {
-  enum class Type { Directional, Point };
+  enum class Type { Directional, Point, Spot };
   Type type = Type::Directional;
-  glm::dvec3 direction{0.0, -1.0, 0.0};  // directional: unit direction the light travels
-  glm::dvec3 position{0.0};              // point
+  glm::dvec3 direction{0.0, -1.0, 0.0};  // directional: unit direction the light travels; spot: its axis
+  glm::dvec3 position{0.0};              // point, spot
   // Directional: irradiance on a plane facing the light (W/m², RGB). Point: radiant intensity
-  // (W/sr, RGB). docs/programs.md --power.
+  // (W/sr, RGB); spot: on its axis. docs/programs.md --power.
   glm::dvec3 power{1.0};
+  double inner_cone_deg = 0.0, outer_cone_deg = 45.0;  // spot: its cone (core/scene.h spotAttenuation)
   nlohmann::json toJson() const;         // as a SCENE.json light
+  // The fraction of `power` a point or spot light sends along the unit direction `dir` (1 but off
+  // a spot's axis).
+  double attenuation(const glm::dvec3& dir) const;
 };
 
 enum class DepositMode { Accumulate, Max };

@@ -627,10 +627,13 @@ std::vector<Patch> pointPatches(const LightSpec& light, const GridSpec& grid, co
     for (int i = 0; i < m; ++i) {
       const double a0 = param(i), a1 = param(i + 1);
       const glm::dvec3 centre = dirAt(0.5 * (a0 + a1), 0.5 * (b0 + b1));
+      // A spot light sends nothing outside its cone (its intensity at the cell's centre direction).
+      const double attenuation = light.attenuation(centre);
+      if (!(attenuation > 0.0)) continue;
       const bool box = rayHitsBox(p, centre, lo, hi);
       if (!box && !rayHitsMap(p, centre, map, options.patch_voxels * voxelEdge(grid))) continue;
       if (!box && leave_direct) {
-        const glm::dvec3 flux = light.power * cubeCellSolidAngle(a0, b0, a1, b1);  // Φ = I·Ω_cell
+        const glm::dvec3 flux = light.power * (attenuation * cubeCellSolidAngle(a0, b0, a1, b1));  // Φ = I·Ω_cell
         DirectCells& d = row_direct[static_cast<std::size_t>(row_index)];
         ++d.cells;
         d.flux += flux;
@@ -646,7 +649,7 @@ std::vector<Patch> pointPatches(const LightSpec& light, const GridSpec& grid, co
         patch.w[c] = sampler.materialOptics(patch.medium[c], patch.x[c]).x * dirs[c];
       }
       patch.area0 = patch.area();
-      patch.flux = light.power * cubeCellSolidAngle(a0, b0, a1, b1);  // Φ = I·Ω_cell
+      patch.flux = light.power * (attenuation * cubeCellSolidAngle(a0, b0, a1, b1));  // Φ = I·Ω_cell
       row.push_back(patch);
     }
   });
@@ -682,6 +685,13 @@ void validateLight(const LightSpec& light) {
       throw InputError("light", "direction", "must be a finite, non-zero vector");
   } else if (!finite3(light.position)) {
     throw InputError("light", "position", "must be finite");
+  }
+  if (light.type == LightSpec::Type::Spot) {
+    if (!finite3(light.direction) || glm::length(light.direction) == 0.0)
+      throw InputError("light", "direction", "a spot light's axis must be a finite, non-zero vector");
+    if (!(light.outer_cone_deg > 0.0 && light.outer_cone_deg <= 90.0 && light.inner_cone_deg >= 0.0 &&
+          light.inner_cone_deg < light.outer_cone_deg))
+      throw InputError("light", "cone", "expected 0 <= inner_cone_deg < outer_cone_deg <= 90");
   }
 }
 

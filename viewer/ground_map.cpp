@@ -15,7 +15,14 @@ glm::dvec3 bakedDirectIrradiance(const ReceiverLayer& layer, const glm::dvec3& x
   if (layer.light_pos.w == 0.0) return layer.light_power * std::max(0.0, -glm::dot(normal, pos));
   const glm::dvec3 L = pos - x;
   const double r2 = std::max(glm::dot(L, L), 1e-12);
-  return layer.light_power * std::max(0.0, glm::dot(normal, L) / std::sqrt(r2)) / r2;
+  double spot = 1.0;
+  if (layer.light_spot_scale > 0.0) {
+    const double t = std::clamp((glm::dot(glm::dvec3(layer.light_spot), -L / std::sqrt(r2)) - layer.light_spot.w) *
+                                    layer.light_spot_scale,
+                                0.0, 1.0);
+    spot = t * t;
+  }
+  return layer.light_power * (spot * std::max(0.0, glm::dot(normal, L) / std::sqrt(r2)) / r2);
 }
 
 bool receiverChangeAt(const ReceiverLayer& layer, const glm::dvec3& xw, glm::dvec3& change) {

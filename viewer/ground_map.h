@@ -26,6 +26,10 @@ struct ReceiverLayer {
   // travel and its irradiance; w = 1 a point light's position and its intensity.
   glm::dvec4 light_pos{0.0, -1.0, 0.0, 0.0};
   glm::dvec3 light_power{0.0};
+  // A spot light's cone (core/scene.h spotAttenuation): its axis and cos θ_outer, and
+  // 1/(cos θ_inner − cos θ_outer); 0: not a spot.
+  glm::dvec4 light_spot{0.0};
+  double light_spot_scale = 0.0;
   // The receiver texture the viewer made of the map (shadow_edge.h receiverTexels: rgb the map with
   // the direct light its geometric shadow takes added back, a the shadow clearance), or null: the
   // map itself.

@@ -39,10 +39,16 @@ std::vector<SceneLightSpec> bakedLights(const Volume& volume) {
       if (glm::length(light.direction) > 0) light.direction = glm::normalize(light.direction);
       light.irradiance = vec("irradiance", light.irradiance);
       lights.push_back(light);
-    } else if (type == "point") {
-      light.type = SceneLightSpec::Type::Point;
+    } else if (type == "point" || type == "spot") {
+      light.type = type == "spot" ? SceneLightSpec::Type::Spot : SceneLightSpec::Type::Point;
       light.position = vec("position", light.position);
       light.intensity = vec("intensity", light.intensity);
+      if (type == "spot") {
+        light.direction = vec("direction", light.direction);
+        if (glm::length(light.direction) > 0) light.direction = glm::normalize(light.direction);
+        light.inner_cone_deg = j.value("inner_cone_deg", light.inner_cone_deg);
+        light.outer_cone_deg = j.value("outer_cone_deg", light.outer_cone_deg);
+      }
       lights.push_back(light);
     }
   } catch (const nlohmann::json::exception&) {

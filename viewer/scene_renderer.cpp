@@ -42,6 +42,8 @@ struct SceneRenderer::Impl {
     gl::Texture2D receiver_texture;
     glm::vec4 receiver_light_pos{0.0f};
     glm::vec3 receiver_light_power{0.0f};
+    glm::vec4 receiver_light_spot{0.0f};
+    float receiver_light_spot_scale = 0.0f;
   };
 
   const gl::ShaderLibrary& shaders;
@@ -76,6 +78,8 @@ struct SceneRenderer::Impl {
     const ReceiverMap* map = nullptr;
     glm::vec4 light_pos{0.0f};
     glm::vec3 light_power{0.0f};
+    glm::vec4 light_spot{0.0f};  // a spot light's axis and cos θ_outer (ReceiverLayer)
+    float light_spot_scale = 0.0f;
   };
   static GroundReceiver findGroundReceiver(const LoadedObject& loaded, const SceneGroundSpec& ground) {
     const glm::dmat4 to_volume = glm::inverse(loaded.object_to_world);
@@ -99,6 +103,12 @@ struct SceneRenderer::Impl {
         } else {
           found.light_pos = glm::vec4(vec3Of("position"), 1.0f);
           found.light_power = vec3Of("intensity");
+          if (light.at("type") == "spot") {
+            const SpotCone cone = spotCone(glm::dvec3(vec3Of("direction")), light.at("inner_cone_deg").get<double>(),
+                                           light.at("outer_cone_deg").get<double>());
+            found.light_spot = cone.axis_cos_outer;
+            found.light_spot_scale = cone.scale;
+          }
         }
       } catch (const nlohmann::json::exception&) {
         throw InputError(loaded.source, "light", "the baked light is malformed");
@@ -112,8 +122,13 @@ struct SceneRenderer::Impl {
   // directional light, sharp interfaces). No GL: SceneRenderer::prepare runs it before a context.
   static std::vector<float> groundTexels(const LoadedObject& loaded, const GroundReceiver& found) {
     const glm::dmat4 to_volume = glm::inverse(loaded.object_to_world);
-    ReceiverLayer layer{found.map, to_volume, loaded.object_to_world, glm::dvec4(found.light_pos),
-                        glm::dvec3(found.light_power)};
+    ReceiverLayer layer{found.map,
+                        to_volume,
+                        loaded.object_to_world,
+                        glm::dvec4(found.light_pos),
+                        glm::dvec3(found.light_power),
+                        glm::dvec4(found.light_spot),
+                        found.light_spot_scale};
     const std::vector<float> clearance =
         found.light_pos.w == 0.0f ? shadowClearance(loaded.volume, *found.map, glm::dvec3(found.light_pos))
                                   : std::vector<float>();
@@ -126,6 +141,8 @@ struct SceneRenderer::Impl {
     if (!found.map) return;
     o.receiver_light_pos = found.light_pos;
     o.receiver_light_power = found.light_power;
+    o.receiver_light_spot = found.light_spot;
+    o.receiver_light_spot_scale = found.light_spot_scale;
     o.receiver = *found.map;  // with its irradiance, for the ground map
     o.receiver_texture = gl::Texture2D(found.map->texels, gl::TextureFormat::RGBA32F,
                                        prepared ? *prepared : groundTexels(loaded, found), 4);
@@ -189,7 +206,9 @@ struct SceneRenderer::Impl {
     std::vector<ReceiverLayer> layers;
     for (const Object& o : objects)
       if (o.has_receiver)
-        layers.push_back({&o.receiver, o.to_volume, o.to_world, glm::dvec4(o.receiver_light_pos), glm::dvec3(o.receiver_light_power)});
+        layers.push_back({&o.receiver, o.to_volume, o.to_world, glm::dvec4(o.receiver_light_pos),
+                          glm::dvec3(o.receiver_light_power), glm::dvec4(o.receiver_light_spot),
+                          o.receiver_light_spot_scale});
     if (layers.size() < 2) return;
     glm::dvec3 u, v;
     const glm::dvec3 normal = glm::normalize(scene.ground->normal);
@@ -278,6 +297,8 @@ struct SceneRenderer::Impl {
         p.set("uObjRecvSize" + i, glm::vec2(glm::dvec2(o.receiver.texels) * o.receiver.pitch));
         p.set("uObjRecvLightPos" + i, o.receiver_light_pos);
         p.set("uObjRecvLightPower" + i, o.receiver_light_power);
+        p.set("uObjRecvLightSpot" + i, o.receiver_light_spot);
+        p.set("uObjRecvLightSpotScale" + i, o.receiver_light_spot_scale);
       }
       p.set("uObjBrickSize" + i, glm::vec3(o.grid.extent() / glm::dvec3(o.grid.dims) * double(kBrickVoxels)));
       // The placement's uniform scale (docs/scene-format.md): a volume unit is this many world units.
@@ -299,6 +320,11 @@ struct SceneRenderer::Impl {
         p.set("uLightPos" + i, glm::vec4(glm::vec3(light.position), 1.0f));
         p.set("uLightPower" + i, glm::vec3(light.intensity));
       }
+      const SpotCone cone = light.type == SceneLightSpec::Type::Spot
+                                ? spotCone(light.direction, light.inner_cone_deg, light.outer_cone_deg)
+                                : SpotCone{};
+      p.set("uLightSpot" + i, glm::vec4(cone.axis_cos_outer));
+      p.set("uLightSpotScale" + i, static_cast<float>(cone.scale));
     }
 
     const glm::vec3 ambient = environment.diffuseRadiance(glm::dvec3(0, 1, 0), light_direction);

@@ -294,6 +294,56 @@ TEST_F(SceneRendererTest, BallLensShowsTheEnvironmentInverted) {
   EXPECT_GT(glm::dot(corner_dir, glm::normalize(glm::dvec3(-0.65, 0.65, -4.0))), 0.999);
 }
 
+// A spot light (glTF KHR_lights_punctual's cone: full intensity within 20° of its axis, none beyond
+// 30°) 2 above the ground, pointing down, seen from straight above: the ground's radiance is
+// ρ/π·I·a(θ)·cos θ/d² at every pixel, a = ((cos θ − cos 30°)/(cos 20° − cos 30°))² clamped to
+// [0, 1] (core/scene.h spotAttenuation), and nothing beyond the cone (a black environment).
+TEST_F(SceneRendererTest, ASpotLightsConeOnTheGround) {
+  const double ground_y = -0.4, height = 2.0, intensity = 3.0;
+  Scene scene;
+  SceneObjectSpec far_away{"ball"};
+  far_away.translate = {50.0, 0.0, 0.0};  // an object the scene needs, out of the picture
+  scene.objects.push_back(far_away);
+  SceneLightSpec spot;
+  spot.type = SceneLightSpec::Type::Spot;
+  spot.position = {0.0, ground_y + height, 0.0};
+  spot.direction = {0.0, -1.0, 0.0};
+  spot.intensity = glm::dvec3(intensity);
+  spot.inner_cone_deg = 20.0;
+  spot.outer_cone_deg = 30.0;
+  scene.lights.push_back(spot);
+  SceneGroundSpec ground;
+  ground.point = {0.0, ground_y, 0.0};
+  ground.albedo = glm::dvec3(1.0);
+  ground.half_extent = 10.0;
+  scene.ground = ground;
+  LoadedScene loaded = sceneFromVolumes(scene, {smoothedVolume(ball({0.0, 0.0, 0.0}, 0.3), 1.5, glm::dvec3(0.0), 16)});
+  applyEnvironmentFlag("uniform:0,0,0", loaded.scene.environment);
+  // 65 pixels over 3 units: pixel (32 + k, 32) sees the ground at x = ±3k/65.
+  const int pixels = 65;
+  const double view = 3.0, distance = 20.0;
+  const double fov = 2 * std::atan(view / 2 / distance) * 180 / kPi;
+  const Image image = render(loaded, lookAt({0, ground_y + distance, 0}, {0, ground_y, 0}, fov, {0, 0, -1}),
+                             {pixels, pixels});
+  save(image, "spot-from-above");
+  const double cos_inner = std::cos(20.0 * kPi / 180.0), cos_outer = std::cos(30.0 * kPi / 180.0);
+  int in_falloff = 0, dark = 0;
+  for (int k = 0; k <= pixels / 2; ++k) {
+    const double r = k * view / pixels, d = std::hypot(r, height), cos_theta = height / d;
+    const double t = std::clamp((cos_theta - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    const double want = intensity * t * t * cos_theta / (d * d) / kPi;
+    const double got = image.at(pixels / 2 + k, pixels / 2)[1];
+    // 1 %: float arithmetic in the shader and the pixel's ray hitting the ground within 10⁻⁴ of
+    // x = 3k/65; past the edge nothing (the black environment's ambient is 0).
+    if (want > 0.0) EXPECT_NEAR(got, want, 0.01 * want + 1e-6) << "r = " << r;
+    else EXPECT_LT(got, 1e-6) << "r = " << r;
+    in_falloff += t > 0.0 && t < 1.0;
+    dark += want == 0.0;
+  }
+  EXPECT_GT(in_falloff, 5);
+  EXPECT_GT(dark, 5);
+}
+
 TEST_F(SceneRendererTest, BakedSphereCastsItsCausticAndShadowOnTheGround) {
   // A glass ball (r = 0.4, n = 1.5) centred 0.55 above the ground, under a vertical directional
   // light of irradiance 1, baked with lightsim's CPU simulator at 40³. Seen from straight above with

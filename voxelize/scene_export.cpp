@@ -1,5 +1,6 @@
 #include "voxelize/scene_export.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace eik {
@@ -46,11 +47,15 @@ SceneExport exportScene(const std::vector<MeshScene>& inputs, const std::filesys
         l.direction = glm::normalize(light.direction);
         l.irradiance = irradianceFromLux(light.color, light.intensity);
       } else {
-        if (light.type == SceneLight::Type::Spot)
-          out.warnings.push_back("spot light '" + light.name + "' exported as a point light (cone dropped)");
-        l.type = SceneLightSpec::Type::Point;
+        l.type = light.type == SceneLight::Type::Spot ? SceneLightSpec::Type::Spot : SceneLightSpec::Type::Point;
         l.position = light.position;
         l.intensity = radiantIntensityFromCandela(light.color, light.intensity);
+        if (light.type == SceneLight::Type::Spot) {
+          // The cone as glTF gives it (radians), kept valid for the scene file: 0 ≤ inner < outer ≤ 90°.
+          l.direction = glm::normalize(light.direction);
+          l.outer_cone_deg = std::clamp(glm::degrees(light.outer_cone_rad), 1e-3, 90.0);
+          l.inner_cone_deg = std::clamp(glm::degrees(light.inner_cone_rad), 0.0, 0.999 * l.outer_cone_deg);
+        }
       }
       scene.lights.push_back(l);
     }

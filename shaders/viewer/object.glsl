@@ -104,7 +104,8 @@ bool receiverChange@(vec3 xw, out vec3 change) {
   if (covered) {
     vec3 normal = cross(uObjRecvU[@], uObjRecvV[@]);
     vec4 m = texture(uO@Receiver, st);
-    vec3 direct = lightIrradiance(uObjRecvLightPos[@], uObjRecvLightPower[@], x, normal);
+    vec3 direct = lightIrradiance(uObjRecvLightPos[@], uObjRecvLightPower[@], uObjRecvLightSpot[@],
+                                  uObjRecvLightSpotScale[@], x, normal);
     change = m.rgb - direct * (m.a >= 0.0 ? 1.0 : 2.0);
   }
 #endif

@@ -44,6 +44,8 @@ uniform vec2 uObjRecvOrigin[OBJECT_COUNT];
 uniform vec2 uObjRecvSize[OBJECT_COUNT];
 uniform vec4 uObjRecvLightPos[OBJECT_COUNT];
 uniform vec3 uObjRecvLightPower[OBJECT_COUNT];
+uniform vec4 uObjRecvLightSpot[OBJECT_COUNT];        // a spot light's axis and cos θ_outer
+uniform float uObjRecvLightSpotScale[OBJECT_COUNT];  // 1/(cos θ_inner − cos θ_outer); 0: not a spot
 
 uniform float uMinTransmittance;  // early termination
 uniform float uMaxOpticalDepth;   // −ln(uMinTransmittance)
@@ -54,7 +56,9 @@ uniform vec3 uAmbientRadiance;    // the environment's diffuse radiance on an up
 
 #if LIGHT_COUNT > 0
 uniform vec4 uLightPos[LIGHT_COUNT];    // w = 0: direction the light travels; w = 1: position
-uniform vec3 uLightPower[LIGHT_COUNT];  // irradiance (directional) or intensity (point)
+uniform vec3 uLightPower[LIGHT_COUNT];  // irradiance (directional) or intensity (point, spot on its axis)
+uniform vec4 uLightSpot[LIGHT_COUNT];   // a spot light's axis and cos θ_outer (core/scene.h spotCone)
+uniform float uLightSpotScale[LIGHT_COUNT];  // 1/(cos θ_inner − cos θ_outer); 0: not a spot
 #endif
 
 #ifdef GROUND
@@ -93,17 +97,25 @@ struct Ray {
 // Irradiance from the scene's lights at x on a surface of normal N, nothing in the way.
 // Planar irradiance at x on a surface of normal N from one light (w = 0: directional, its
 // irradiance; w = 1: point, its intensity), unoccluded: E·cos θ, or I·cos θ/r².
-vec3 lightIrradiance(vec4 pos, vec3 power, vec3 x, vec3 N) {
+// A light's irradiance at x on a surface of normal N; a spot light's (spotScale > 0) with glTF's
+// cone, clamp((axis·d − cos θ_outer)·scale, 0, 1)² (core/scene.h spotAttenuation).
+vec3 lightIrradiance(vec4 pos, vec3 power, vec4 spot, float spotScale, vec3 x, vec3 N) {
   if (pos.w == 0.0) return power * max(0.0, -dot(N, pos.xyz));
   vec3 L = pos.xyz - x;
   float r2 = max(dot(L, L), 1e-12);
-  return power * max(0.0, dot(N, L) * inversesqrt(r2)) / r2;
+  float cone = 1.0;
+  if (spotScale > 0.0) {
+    float t = clamp((dot(spot.xyz, -L * inversesqrt(r2)) - spot.w) * spotScale, 0.0, 1.0);
+    cone = t * t;
+  }
+  return power * (cone * max(0.0, dot(N, L) * inversesqrt(r2)) / r2);
 }
 
 vec3 unoccludedIrradiance(vec3 x, vec3 N) {
   vec3 E = vec3(0.0);
 #if LIGHT_COUNT > 0
-  for (int i = 0; i < LIGHT_COUNT; ++i) E += lightIrradiance(uLightPos[i], uLightPower[i], x, N);
+  for (int i = 0; i < LIGHT_COUNT; ++i)
+    E += lightIrradiance(uLightPos[i], uLightPower[i], uLightSpot[i], uLightSpotScale[i], x, N);
 #endif
   return E;
 }
