@@ -11,6 +11,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/testing.h"
+#include "voxelize/scene_export.h"
 
 namespace eik {
 namespace {
@@ -91,6 +92,35 @@ TEST(GltfLightsCameras, CamerasLookAlongMinusZ) {
   node.camera = 7;
   EXPECT_EQ(inputErrorOf([&] { gltfCamera(model, node, "nodes[2]", world, diag); }),
             "s.gltf: nodes[2].camera: camera 7 out of range (the file has 2 cameras)");
+}
+
+// A glTF spot light goes into the scene as a spot (docs/programs.md "Lights and cameras"): its
+// axis, its cone in degrees, its candela as W/sr at 683 lm/W, and no warning.
+TEST(GltfLightsCameras, ASpotLightIsExportedWithItsCone) {
+  MeshScene in;
+  SceneLight spot;
+  spot.type = SceneLight::Type::Spot;
+  spot.name = "lamp";
+  spot.position = {1.0, 2.0, 3.0};
+  spot.direction = {0.0, -1.0, 0.0};
+  spot.color = {1.0, 0.5, 0.25};
+  spot.intensity = 683.0;
+  spot.inner_cone_rad = 0.1;
+  spot.outer_cone_rad = 0.4;
+  in.lights.push_back(spot);
+  GridSpec grid;
+  grid.dims = {8, 8, 8};
+  grid.bounds_max = glm::dvec3(1.0);
+  const SceneExport out = exportScene({in}, "lamp.vol.json", grid);
+  ASSERT_EQ(out.scene.lights.size(), 1u);
+  const SceneLightSpec& l = out.scene.lights[0];
+  EXPECT_EQ(l.type, SceneLightSpec::Type::Spot);
+  EXPECT_EQ(l.position, glm::dvec3(1.0, 2.0, 3.0));
+  EXPECT_EQ(l.direction, glm::dvec3(0.0, -1.0, 0.0));
+  EXPECT_NEAR(l.inner_cone_deg, glm::degrees(0.1), 1e-12);
+  EXPECT_NEAR(l.outer_cone_deg, glm::degrees(0.4), 1e-12);
+  EXPECT_NEAR(glm::length(l.intensity - glm::dvec3(1.0, 0.5, 0.25)), 0.0, 1e-12);
+  EXPECT_TRUE(out.warnings.empty());
 }
 
 }  // namespace

@@ -16,7 +16,7 @@ namespace eik {
 struct SceneExport {
   Scene scene;
   bool from_gltf = false;              // some input brought a light or a camera
-  std::vector<std::string> warnings;   // e.g. a spot light exported as a point light
+  std::vector<std::string> warnings;   // what was approximated (none so far)
 };
 
 // Photometric → radiometric (docs/scene-format.md is linear radiometry): glTF gives a directional light's
