@@ -485,6 +485,19 @@ TEST(ExactOpticsFreeAir, EveryVoxelAndTexelGetsTheBeamsIrradiance) {
     }
 }
 
+// The map of a light over the floor y = −0.6 (half extent `half_extent`), through the 32³ box
+// [−0.5, 0.5]³ of air.
+BakeResult bakeThroughAirOntoTheFloor(const LightSpec& light, double half_extent, double patch_voxels = 1.0) {
+  CpuSimulator sim(uniformVolume(cubicGrid(32, 0.5), 1.0));
+  SimulationOptions options;
+  options.patch_voxels = patch_voxels;
+  ReceiverSpec floor;
+  floor.point = {0.0, -0.6, 0.0};
+  floor.half_extent = half_extent;
+  options.receiver = floor;
+  return sim.run(light, options);
+}
+
 // A point light of intensity I over a floor, through a box of air: the floor's planar irradiance
 // is I·cos θ / d² = I·h / d³ at every texel (h the light's height over the floor, d its distance),
 // the inverse-square law with the cosine of incidence. The light sits off the box's axis, so the
@@ -492,20 +505,13 @@ TEST(ExactOpticsFreeAir, EveryVoxelAndTexelGetsTheBeamsIrradiance) {
 // closed form (directMapLight). Returns the worst texel of each: {beside the box, through it}.
 std::pair<double, double> pointLightOverAFloor(double patch_voxels) {
   const GridSpec g = cubicGrid(32, 0.5);
-  CpuSimulator sim(uniformVolume(g, 1.0));
   LightSpec light;
   light.type = LightSpec::Type::Point;
   light.position = {0.1, 1.5, -0.05};
   light.power = glm::dvec3(3.0);  // W/sr
-  SimulationOptions options;
-  options.patch_voxels = patch_voxels;
-  ReceiverSpec floor;
-  floor.point = {0.0, -0.6, 0.0};
-  floor.half_extent = 1.5;
-  options.receiver = floor;
-  const BakeResult r = sim.run(light, options);
+  const BakeResult r = bakeThroughAirOntoTheFloor(light, 1.5, patch_voxels);
   const ReceiverMap& map = r.receivers.at(0);
-  const double h = light.position.y - floor.point.y;
+  const double h = light.position.y + 0.6;
   double beside = 0.0, through = 0.0, nearest = 1e30, farthest = 0.0;
   std::size_t lit = 0, crossed = 0;
   for (int j = 0; j < map.texels.y; ++j)
@@ -559,8 +565,6 @@ TEST(ExactOpticsFreeAir, APointLightFallsOffByTheInverseSquareLaw) {
 // a box of air whose corners lie within 27° of the axis: the floor's irradiance is I·a(θ)·cos θ/d² at
 // every texel, and the lit disc ends at r = 2.6·tan 40°.
 TEST(ExactOpticsFreeAir, ASpotLightsConeEndsWhereItsOuterAngleMeetsTheFloor) {
-  const GridSpec g = cubicGrid(32, 0.5);
-  CpuSimulator sim(uniformVolume(g, 1.0));
   LightSpec light;
   light.type = LightSpec::Type::Spot;
   light.position = {0.0, 2.0, 0.0};
@@ -568,14 +572,9 @@ TEST(ExactOpticsFreeAir, ASpotLightsConeEndsWhereItsOuterAngleMeetsTheFloor) {
   light.inner_cone_deg = 30.0;
   light.outer_cone_deg = 40.0;
   light.power = glm::dvec3(3.0);  // W/sr on the axis
-  SimulationOptions options;
-  ReceiverSpec floor;
-  floor.point = {0.0, -0.6, 0.0};
-  floor.half_extent = 2.5;
-  options.receiver = floor;
-  const BakeResult r = sim.run(light, options);
+  const BakeResult r = bakeThroughAirOntoTheFloor(light, 2.5);
   const ReceiverMap& map = r.receivers.at(0);
-  const double h = light.position.y - floor.point.y;
+  const double h = light.position.y + 0.6;
   const double cos_inner = std::cos(glm::radians(30.0)), cos_outer = std::cos(glm::radians(40.0));
   double worst = 0.0, last_lit = 0.0, first_dark = 1e30;
   int falloff = 0;
