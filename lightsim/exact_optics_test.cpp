@@ -331,7 +331,11 @@ SphereBake bakePlacedSphereOnFloor(int res) {
 }
 
 TEST(ExactOpticsSphere, APlacedVolumeBakesTheCausticWhereTheSceneStandsIt) {
+  const SphereBake coarse = bakePlacedSphereOnFloor(32);
   const SphereBake placed = bakePlacedSphereOnFloor(48);
+  // It converges as the unplaced bake does (5.1 → 2.4 %): measured 4.9 % at 32³, 2.7 % at 48³.
+  EXPECT_LT(placed.mean_deviation, coarse.mean_deviation);
+  EXPECT_NEAR(coarse.rings.shadow_radius, 1.0, 0.01);
   // The unplaced bake's bounds at 48³ (expectConvergesToExactOptics: measured 2.4 % mean, 6.4 %
   // worst; 3.3 % and 16 % through the map's texels; the shadow's edge within 0.24 voxel).
   EXPECT_LT(placed.mean_deviation, 0.05);
