@@ -607,6 +607,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   std::vector<Patch> patches = initialPatches(light, grid, sampler_, options, &flux_ref, ctx.receiver, &direct);
   std::vector<glm::dvec3> direct_flux;
   if (direct.cells > 0) direct_flux = directMapLight(receiver, light, patches);
+  adjustInitialPatches(patches, sampler_, options, flux_ref);
   ctx.flux_ref = flux_ref;
   ctx.dim_irradiance = kDimTrackFraction * brightestIrradiance(light, grid);
   stats.initial_patches = patches.size();
@@ -694,6 +695,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
         case PatchFate::Exited:
           ++stats.kills.exited;
           stats.flux_out += p.flux;
+          if (options.on_leave) options.on_leave(p);
           if (diagnostics) diagnostics->flux_out_by_face[exitFace(p.midpoint(), p.direction(), grid)] += p.flux;
           break;
         case PatchFate::Folded:
@@ -712,6 +714,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
           ++stats.kills.received;
           stats.flux_received += r.received;
           received.push_back(static_cast<std::uint32_t>(i));
+          if (options.on_leave && !insideBox(p.midpoint(), ctx.box_lo, ctx.box_hi)) options.on_leave(p);
           break;
         case PatchFate::Blocked:
           ++stats.kills.blocked;

@@ -283,6 +283,9 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   if (options.receiver && !track)
     throw InputError("lightsim options", "receiver",
                      "the GPU path makes receiver maps with track deposits only (deposit accumulate, kernel track)");
+  if (options.on_leave)
+    throw InputError("lightsim options", "on_leave",
+                     "the GPU path does not hand the light that leaves its box on (make_simulator.h gpuPathLacks)");
   const PatchLayout layout = sharp ? PatchLayout::Sharp : PatchLayout::Smooth;
 
   // Initialisation (§6.2.1) on the CPU, shared with the twin; the receiver's map geometry first
@@ -294,10 +297,11 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   if (options.receiver) receiver = receiverGeometry(*options.receiver, light, grid, boxLo, boxHi);
   double fluxRef = 0.0;
   DirectCells direct;  // cells that go straight to the receiver's map: in closed form, not followed
-  const std::vector<Patch> initial = initialPatches(light, grid, sampler, options, &fluxRef,
-                                                    options.receiver ? &receiver : nullptr, &direct);
+  std::vector<Patch> initial = initialPatches(light, grid, sampler, options, &fluxRef,
+                                              options.receiver ? &receiver : nullptr, &direct);
   std::vector<glm::dvec3> directFlux;
   if (direct.cells > 0) directFlux = directMapLight(receiver, light, initial);
+  adjustInitialPatches(initial, sampler, options, fluxRef);
   stats.initial_patches = initial.size();
   for (const Patch& p : initial) stats.flux_in += p.flux;
   if (initial.empty()) {  // the light misses the volume: an empty bake

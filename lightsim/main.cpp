@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -198,7 +199,8 @@ int run(int argc, char** argv) {
   // `stats_file`): the whole of a volume's bake, and one object's of a scene's. `scale` is the
   // object's (scene_bake.h); light and receiver are given in its bake frame.
   auto bake = [&](Volume& volume, const std::string& source, const LightSpec& light, SimulationOptions options,
-                  const std::string& out, const std::string& stats_file, double scale) {
+                  const std::string& out, const std::string& stats_file, double scale,
+                  const std::function<void(BakeResult&)>& after_run = {}) {
     const std::string& output = out;
     const std::string& stats_path = stats_file;
     const VolumeDefaults defaults = volumeDefaults(volume.has("interfaces"), volume.grid);
@@ -272,6 +274,7 @@ int run(int argc, char** argv) {
     if (lightMissedVolume(result.stats))
       std::fprintf(stderr, "lightsim: warning: the light misses the volume; the bake is empty\n");
 
+    if (after_run) after_run(result);
     if (smooth_irradiance > 0.0) smoothIrradiance(result, volume.grid, smooth_irradiance);
     LightSpec baked_light = light;
     bakeToVolumeFrame(result, baked_light, scale);
@@ -350,15 +353,39 @@ int run(int argc, char** argv) {
         name = stem + "-" + std::to_string(k) + ".baked.vol.json";
       names.push_back(name);
     }
+    // The objects in the order the light meets them, each handing on what leaves its box
+    // (scene_bake.h SceneLightChain).
+    std::vector<SceneLightChain::Object> boxes;
+    for (std::size_t i = 0; i < volumes.size(); ++i) {
+      SceneLightChain::Object box;
+      box.frame = BakeFrame::of(scene.objects[i]);
+      GridSpec grid = volumes[i].grid;
+      grid.bounds_min *= box.frame.scale;
+      grid.bounds_max *= box.frame.scale;
+      propagationBox(grid, options, box.lo, box.hi);
+      box.h = voxelEdge(grid);
+      boxes.push_back(box);
+    }
+    SceneLightChain chain(boxes, world_light, ground);
     fs::create_directories(out_dir);
     Scene baked = scene;
-    for (std::size_t i = 0; i < volumes.size(); ++i) {
+    for (std::size_t step = 0; step < volumes.size(); ++step) {
+      const std::size_t i = chain.order()[step];
       const BakeFrame frame = BakeFrame::of(scene.objects[i]);
       SimulationOptions object_options = options;
       if (ground) object_options.receiver = frame.receiver(*ground);
-      if (!quiet) std::fprintf(stderr, "lightsim: [%zu/%zu] %s\n", i + 1, volumes.size(), sources[i].c_str());
+      chain.attach(i, object_options);
+      if (!quiet) std::fprintf(stderr, "lightsim: [%zu/%zu] %s\n", step + 1, volumes.size(), sources[i].c_str());
       bake(volumes[i], sources[i], frame.light(world_light), object_options, (out_dir / names[i]).string(), "",
-           frame.scale);
+           frame.scale, [&](BakeResult& result) {
+             chain.correctMap(i, result);
+             const SceneLightChain::Exchange& x = chain.exchange(i);
+             if (!quiet && (x.taken_in > 0 || x.left_out > 0))
+               std::fprintf(stderr,
+                            "lightsim: from the objects before it: %zu patches (%.4g W) taken in, %zu of the light's "
+                            "cells (%.4g W) shaded\n",
+                            x.taken_in, luminance(x.flux_in), x.left_out, luminance(x.flux_left_out));
+           });
       volumes[i] = Volume();  // its memory for the next object's bake
       baked.objects[i].volume = names[i];
     }

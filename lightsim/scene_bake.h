@@ -11,11 +11,16 @@
 // uniform scale, so the same rays bend the same way, only s times as long.
 #pragma once
 
+#include <cstddef>
+#include <optional>
+#include <vector>
+
 #include <glm/glm.hpp>
 
 #include "core/scene.h"
 #include "core/volume.h"
 #include "lightsim/simulator.h"
+#include "lightsim/wavefront.h"
 
 namespace eik {
 
@@ -39,5 +44,68 @@ Volume volumeAtWorldScale(const Volume& volume, double scale);
 // A bake made in the bake frame, back in the volume's own coordinates: each receiver map's point,
 // origin and pitch ÷ s (its irradiance, W/m², stays), and a point light's position ÷ s.
 void bakeToVolumeFrame(BakeResult& result, LightSpec& light, double scale);
+
+// Light from object to object (docs/programs.md "A whole scene", lightsim/ALGORITHM.md "From box
+// to box"). The objects are baked one after another in the order the light meets them: a sun's,
+// by the nearest corner of each box along the light; a point light's, by the distance to each box.
+// Each object's bake
+//  - leaves out the light's cells whose ray met an earlier object's box before its own (the light
+//    that earlier object took), and
+//  - takes in, as initial patches, the patches that left earlier objects' boxes towards its box
+//    (nearer along their rays than the ground and any other later box), flown in a straight line
+//    (air) to half a voxel before its box;
+// so a shadow falls on what stands behind an object, and a caustic an object throws goes on
+// through the next. Each object's receiver map is then made to hold the direct light D plus its
+// own change to the ground, given the light it got:
+//   map = D + G(its light through it) − G(its light going straight),
+// correctMap below; the sum D + Σ (map_k − D) that the viewer draws on the ground is then the
+// light that went through all the objects in turn (exact for light that crosses each box once in
+// the chain's order). Light sent back towards an earlier object, and objects whose boxes overlap
+// (whose light is baked as if the other were not there), are not followed: the chain runs once.
+class SceneLightChain {
+ public:
+  struct Object {
+    BakeFrame frame;
+    glm::dvec3 lo{0.0}, hi{0.0};  // its propagation box (wavefront.h propagationBox) in its bake frame
+    double h = 0.0;               // its voxel edge at world scale
+  };
+  // `world_light` and `ground` (nullopt: none) in the world.
+  SceneLightChain(std::vector<Object> objects, const LightSpec& world_light, std::optional<ReceiverSpec> ground);
+
+  // The objects in the order they are baked (indices into the constructor's list).
+  const std::vector<std::size_t>& order() const { return order_; }
+  // Do the two objects' boxes overlap (then neither shades or lights the other)?
+  bool overlap(std::size_t a, std::size_t b) const;
+
+  // The hooks of object k's bake (SimulationOptions::initial_patches, on_leave), k being the next
+  // object of order(): what earlier objects shade and send, and (when objects follow) what it sends
+  // on. Objects must be baked in order().
+  void attach(std::size_t k, SimulationOptions& options);
+  // After object k's bake (in its bake frame): its receiver map made D + its own change, by the
+  // straight light of the cells it left out (added) and of the patches it took in (taken away).
+  void correctMap(std::size_t k, BakeResult& result);
+  // What object k took in (its initial patches from earlier objects) and left out, in number and
+  // flux (W, RGB), for the report.
+  struct Exchange {
+    std::size_t taken_in = 0, left_out = 0;
+    glm::dvec3 flux_in{0.0}, flux_left_out{0.0};
+  };
+  const Exchange& exchange(std::size_t k) const { return exchange_[k]; }
+
+ private:
+  // The entry and exit parameters of the line origin + t·dir through object k's box, in the world;
+  // false when it misses.
+  bool lineThroughBox(std::size_t k, const glm::dvec3& origin, const glm::dvec3& dir, double& t_near,
+                      double& t_far) const;
+  std::vector<Object> objects_;
+  LightSpec light_;  // in the world
+  std::optional<ReceiverSpec> ground_;
+  std::vector<std::size_t> order_;
+  std::vector<std::size_t> rank_;              // rank_[k]: k's place in order_
+  std::vector<std::vector<Patch>> inbox_;      // patches sent to each object, in the world
+  std::vector<std::vector<Patch>> left_out_;   // each object's left-out cells, in its bake frame
+  std::vector<std::vector<Patch>> taken_in_;   // …and the patches it took in, as flown into its box
+  std::vector<Exchange> exchange_;
+};
 
 }  // namespace eik

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -22,6 +23,9 @@
 #include "core/volume.h"
 
 namespace eik {
+
+struct Patch;          // lightsim/wavefront.h
+class VolumeSampler;   // lightsim/wavefront.h
 
 struct LightSpec {
   enum class Type { Directional, Point, Spot };
@@ -110,6 +114,16 @@ struct SimulationOptions {
   // Set by another thread (the viewer window's background re-bake, viewer/background_bake.h): the
   // run stops at its next step and throws BakeCancelled. Null: never cancelled.
   const std::atomic<bool>* cancel = nullptr;
+  // Light from object to object (a scene's bake, lightsim/scene_bake.h "SceneLightChain"):
+  //  - initial_patches, when set, is given the initial patches once they are made (and the direct
+  //    light is on the receiver's map) and may take some away (those an earlier object shades) and
+  //    add others (the light an earlier object sends on), with the volume's sampler for their
+  //    corners' materials. Both back ends.
+  //  - on_leave, when set, is given every patch as it leaves the box (exited, or headed for the
+  //    receiver from outside the box), after the step that took it out, in the order of the patch
+  //    list (deterministic). The CPU twin only (make_simulator.h gpuPathLacks).
+  std::function<void(std::vector<Patch>& patches, const VolumeSampler& sampler)> initial_patches;
+  std::function<void(const Patch& patch)> on_leave;
 };
 
 // What `lightsim` takes, unless told otherwise, for a volume with sharp interfaces or a smoothed n

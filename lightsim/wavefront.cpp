@@ -713,6 +713,13 @@ std::vector<Patch> initialPatches(const LightSpec& light, const GridSpec& grid, 
   return patches;
 }
 
+void adjustInitialPatches(std::vector<Patch>& patches, const VolumeSampler& sampler, const SimulationOptions& options,
+                          double& flux_ref) {
+  if (!options.initial_patches) return;
+  options.initial_patches(patches, sampler);
+  for (const Patch& patch : patches) flux_ref = std::max(flux_ref, std::max(patch.flux.x, std::max(patch.flux.y, patch.flux.z)));
+}
+
 // ---------------------------------------------------------------------------------------------
 // Constants of a run
 

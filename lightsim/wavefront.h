@@ -307,6 +307,11 @@ std::vector<Patch> initialPatches(const LightSpec& light, const GridSpec& grid, 
                                   const SimulationOptions& options, double* flux_ref,
                                   const ReceiverMap* map = nullptr, DirectCells* direct = nullptr);
 
+// Gives the initial patches to options.initial_patches, when set (a scene's light from object to
+// object, simulator.h), and raises `flux_ref` to the largest flux of a patch it added.
+void adjustInitialPatches(std::vector<Patch>& patches, const VolumeSampler& sampler, const SimulationOptions& options,
+                          double& flux_ref);
+
 // ---------------------------------------------------------------------------------------------
 // Constants of a run.
 
