@@ -26,6 +26,7 @@
 #include "lightsim/ledger_pass.h"
 #include "lightsim/list_set.h"
 #include "lightsim/live_count.h"
+#include "lightsim/morton.h"
 #include "lightsim/patch_textures.h"
 #include "lightsim/quiet_texture.h"
 #include "lightsim/receiver.h"
@@ -283,9 +284,6 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   if (options.receiver && !track)
     throw InputError("lightsim options", "receiver",
                      "the GPU path makes receiver maps with track deposits only (deposit accumulate, kernel track)");
-  if (options.on_leave)
-    throw InputError("lightsim options", "on_leave",
-                     "the GPU path does not hand the light that leaves its box on (make_simulator.h gpuPathLacks)");
   const PatchLayout layout = sharp ? PatchLayout::Sharp : PatchLayout::Smooth;
 
   // Initialisation (§6.2.1) on the CPU, shared with the twin; the receiver's map geometry first
@@ -468,6 +466,30 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
     updatePass.run(L.a, L.b, live, slots, volume, gridUniforms, step, maps);
     timer.start("analysis");
     analysisPass.run(L.b, L.a, live, slots, L.targets, volume, gridUniforms, step);
+    if (options.on_leave) {
+      // The patches that left the box this step (a scene's light from object to object,
+      // SimulationOptions::on_leave), read back in list order: exited, or received from outside the
+      // box. Only scenes of several objects ask for it; it costs a read of the fate codes a step,
+      // and of the patch list on the steps where one left.
+      timer.start("leaving");
+      const std::vector<float> codes = L.targets.ledgerA.download(4);
+      const int side = L.a.side();
+      std::vector<std::size_t> leaving;
+      for (std::size_t k = 0; k < slots; ++k) {
+        const glm::ivec2 t = mortonTexel(static_cast<std::uint32_t>(k));
+        const int fate = static_cast<int>(codes[(static_cast<std::size_t>(t.y) * static_cast<std::size_t>(side) +
+                                                 static_cast<std::size_t>(t.x)) * 4 + 3]) & 15;
+        if (fate == gpu::kFateExited || fate == gpu::kFateReceived) leaving.push_back(k);
+      }
+      if (!leaving.empty()) {
+        const std::vector<PatchTexels> after = L.b.download(slots);
+        for (const std::size_t k : leaving) {
+          Patch patch = unpackPatch(after[k], layout);
+          for (glm::dvec3& x : patch.x) x += origin;
+          if (!insideBox(patch.midpoint(), boxLo, boxHi)) options.on_leave(patch);
+        }
+      }
+    }
     timer.start("deposit");
     if (!options.volume_deposits) {
       // only the receiver's map (below)

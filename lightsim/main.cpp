@@ -380,11 +380,15 @@ int run(int argc, char** argv) {
            frame.scale, [&](BakeResult& result) {
              chain.correctMap(i, result);
              const SceneLightChain::Exchange& x = chain.exchange(i);
-             if (!quiet && (x.taken_in > 0 || x.left_out > 0))
-               std::fprintf(stderr,
-                            "lightsim: from the objects before it: %zu patches (%.4g W) taken in, %zu of the light's "
-                            "cells (%.4g W) shaded\n",
-                            x.taken_in, luminance(x.flux_in), x.left_out, luminance(x.flux_left_out));
+             if (!quiet && x.taken_in > 0)
+               std::fprintf(stderr, "lightsim: from the objects before it: %zu patches (%.4g W) taken in\n", x.taken_in,
+                            luminance(x.flux_in));
+             if (!quiet && x.passed > 0)
+               std::fprintf(stderr, "lightsim: %zu patches (%.4g W) sent on too dim to follow: they pass unchanged\n",
+                            x.passed, luminance(x.flux_passed));
+             if (!quiet && x.left_out > 0)
+               std::fprintf(stderr, "lightsim: %zu of the light's cells (%.4g W) in their shade\n", x.left_out,
+                            luminance(x.flux_left_out));
            });
       volumes[i] = Volume();  // its memory for the next object's bake
       baked.objects[i].volume = names[i];

@@ -15,7 +15,6 @@ std::string gpuPathLacks(const Volume& volume, const SimulationOptions& simulati
   (void)volume;
   const bool track = simulation.deposit == DepositMode::Accumulate && simulation.deposit_kernel == DepositKernel::Track;
   if (simulation.receiver && !track) return "receiver maps with point deposits (use --deposit-kernel track)";
-  if (simulation.on_leave) return "handing the light that leaves a box on to the scene's next object";
   return "";
 }
 

@@ -68,6 +68,8 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+double maxChannel(const glm::dvec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
+
 // A patch carried from one frame to another: corners by `to·x + shift`, directions by `to·w`.
 Patch carried(const Patch& patch, const glm::dmat3& to, const glm::dvec3& shift) {
   Patch out = patch;
@@ -200,9 +202,17 @@ void SceneLightChain::attach(std::size_t k, SimulationOptions& options) {
       }
       patches.swap(kept);
     }
-    // The patches earlier objects sent here, flown to half a voxel before the box.
+    // The patches earlier objects sent here, flown to half a voxel before the box; those dimmer than
+    // kDimHandOn of the light's brightest irradiance on the box go on through it unchanged (they
+    // stay on the sender's map, and this object's map does not take them away).
+    const double dim = kDimHandOn * brightestIrradiance(self.frame.light(light_), sampler.grid());
     for (const Patch& sent : inbox_[k]) {
       Patch p = toFrame(sent, self.frame);
+      if (maxChannel(p.irradiance()) < dim) {
+        ++exchange.passed;
+        exchange.flux_passed += p.flux;
+        continue;
+      }
       // In the bake frame the box is axis-aligned: where the midpoint's ray enters it.
       const glm::dvec3 m = p.midpoint(), d = p.direction();
       double t_near = -kInf;

@@ -121,7 +121,7 @@ struct SimulationOptions {
   //    corners' materials. Both back ends.
   //  - on_leave, when set, is given every patch as it leaves the box (exited, or headed for the
   //    receiver from outside the box), after the step that took it out, in the order of the patch
-  //    list (deterministic). The CPU twin only (make_simulator.h gpuPathLacks).
+  //    list (deterministic). Both back ends (the GPU path reads the patches back).
   std::function<void(std::vector<Patch>& patches, const VolumeSampler& sampler)> initial_patches;
   std::function<void(const Patch& patch)> on_leave;
 };

@@ -21,6 +21,10 @@
 
 namespace eik::gpu {
 
+// Fate codes read back on the CPU (ledgerA's w & 15), as shaders/lightsim/fate_codes.glsl defines them.
+constexpr int kFateExited = 5;    // FATE_EXITED
+constexpr int kFateReceived = 9;  // FATE_RECEIVED
+
 struct StepTargets {
   HistoPyramid pyramid;
   gl::Texture2D depositA, depositB, ledgerA, ledgerB;  // RGBA32F

@@ -309,6 +309,43 @@ TEST(LightsimCli, BakesAWholeSceneIntoAFolderTheViewerOpens) {
   }
 }
 
+// A tiny museum: a dark glass slab (σa = 6 per unit: e^−1.2 through its 0.2 thickness) hangs
+// over a sphere in the sun. Baked as one scene the sphere stands in the slab's shadow and gets the
+// light that came through it (scene_bake.h SceneLightChain): its baked irradiance, summed over its
+// grid, is e^−1.2 ≈ 0.30 of what it gets with the slab moved aside (less: the slab's faces reflect
+// a little). Tolerance: the slab's box is wider than the sphere's (its sides' light misses the
+// sphere alike in both scenes); 0.25–0.40 would hold any reasonable discretisation, while a sphere
+// baked in the full sun (the chain off) gets 1.0.
+TEST(LightsimCli, AnObjectBehindAnotherFromTheLightGetsLessLight) {
+  TempDir dir;
+  makeSphere(dir, true);
+  ProgramResult slab = runProgram(VOXELIZE_EXE,
+                                  {"procedural:box,size=1.6:0.2:1.6,ior=1.5,sigma_a=6:6:6", "-o", "slab.vol.json",
+                                   "--res", "24", "--interfaces", "sharp", "--quiet"},
+                                  dir.path());
+  ASSERT_EQ(slab.exit_code, 0) << slab.output;
+  double sums[2] = {0.0, 0.0};
+  for (int aside = 0; aside < 2; ++aside) {
+    writeFile(dir / "SCENE.json", std::string(R"({
+      "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": [1, 1, 1]}],
+      "ground": {"point": [0, -0.6, 0], "normal": [0, 1, 0], "half_extent": 3},
+      "objects": [{"volume": "sharp.vol.json"},
+                  {"volume": "slab.vol.json", "translate": [)") + (aside ? "2.5" : "0") + R"(, 1.2, 0]}]})");
+    const std::string out = aside ? "aside" : "above";
+    ProgramResult r = runProgram(LIGHTSIM_EXE, {"SCENE.json", "-o", out, "--volume-deposits", "on"}, dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    // The slab is baked first (the light meets it first), then the sphere with what came through.
+    EXPECT_LT(r.output.find("slab.vol.json"), r.output.find("sharp.vol.json")) << r.output;
+    EXPECT_EQ(r.output.find("in their shade") != std::string::npos, aside == 0) << r.output;
+    const Volume sphere = readVolume(dir / out / "sharp.baked.vol.json");
+    const Field& e = sphere.require("irradiance", 3);
+    for (float v : e.data) sums[aside] += v;
+  }
+  std::printf("the sphere's irradiance under the slab / beside it: %.4f\n", sums[0] / sums[1]);
+  EXPECT_GT(sums[0] / sums[1], 0.25);
+  EXPECT_LT(sums[0] / sums[1], 0.40);
+}
+
 // Ctrl-C (SIGINT) or a kill (SIGTERM) during a bake: exit 130 / 143, a message, and no output file
 // or temporary left (core/interrupt.h). The bake repeats (--bench); the signal is sent once the first
 // repetition has reported, so it finds the program at work whatever the machine's load.
