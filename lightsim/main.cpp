@@ -30,6 +30,7 @@
 #include "lightsim/bake.h"
 #include "lightsim/make_simulator.h"
 #include "lightsim/scene_bake.h"
+#include "lightsim/spectral_bake.h"
 #include "lightsim/wavefront.h"
 
 namespace fs = std::filesystem;
@@ -67,6 +68,7 @@ int run(int argc, char** argv) {
   SimulationOptions options;
   double options_receiver_pitch = 0.25;
   int bench_runs = 0;
+  int band_count = 3;
   double smooth_irradiance = 0.0;
   bool quiet = false, raw = false;
   CLI::App app{
@@ -95,6 +97,12 @@ int run(int argc, char** argv) {
   app.add_option("--receiver-pitch", options_receiver_pitch,
                  "texel edge of the receiver map in voxels of the volume (default 0.25)")
       ->check(CLI::Range(0.01, 8.0));
+  app.add_option("--bands", band_count,
+                 "spectral bands of a dispersive volume (a dispersion field or a slot with a Cauchy B), each "
+                 "propagated with its own n(lambda): 3 (default: R, G, B at the viewer's 0.61, 0.55, 0.465 um), 1 "
+                 "(none), or 4 to 16 (equal bands over 0.38-0.78 um, to RGB by the CIE 1931 matching functions); a "
+                 "volume without dispersion is baked once")
+      ->check(CLI::Range(1, kMaxSpectralBands));
   app.add_option("--bounces", options.bounces,
                  "Fresnel reflections at sharp interfaces followed as wavefronts of their own (default 1; 0: their "
                  "flux is counted as reflected)")
@@ -198,9 +206,14 @@ int run(int argc, char** argv) {
   // Bakes `volume` (read from `source`) with `light` and writes it to `out` (and the stats to
   // `stats_file`): the whole of a volume's bake, and one object's of a scene's. `scale` is the
   // object's (scene_bake.h); light and receiver are given in its bake frame.
+  // What a scene's bake does around each spectral band's run of one object (its chain per band).
+  struct BandHooks {
+    std::function<void(std::size_t band, SimulationOptions&)> before;
+    std::function<void(std::size_t band, BakeResult&)> after;
+  };
   auto bake = [&](Volume& volume, const std::string& source, const LightSpec& light, SimulationOptions options,
                   const std::string& out, const std::string& stats_file, double scale,
-                  const std::function<void(BakeResult&)>& after_run = {}) {
+                  const std::vector<SpectralBand>& bands, const BandHooks& hooks = {}) {
     const std::string& output = out;
     const std::string& stats_path = stats_file;
     const VolumeDefaults defaults = volumeDefaults(volume.has("interfaces"), volume.grid);
@@ -234,14 +247,44 @@ int run(int argc, char** argv) {
     // The bake runs in the object's bake frame (scene_bake.h): the volume at world scale.
     const std::optional<Volume> scaled =
         scale != 1.0 ? std::optional<Volume>(volumeAtWorldScale(volume, scale)) : std::nullopt;
-    const std::unique_ptr<Simulator> simulator = makeSimulator(scaled ? *scaled : volume, choice, &options);
+    const Volume& at_scale = scaled ? *scaled : volume;
+    // One band: one simulator for every run. Several (spectral_bake.h): the volume at each band's
+    // wavelength, a simulator each, made in turn, the band's share of the light's power, and the
+    // bands' bakes summed.
+    std::unique_ptr<Simulator> simulator = bands.size() == 1 ? makeSimulator(at_scale, choice, &options) : nullptr;
+    if (bands.size() > 1 && !quiet)
+      std::fprintf(stderr, "lightsim: dispersive: %zu spectral bands, %.3f to %.3f um, each with its own n(lambda)\n",
+                   bands.size(), bands.front().lambda_um, bands.back().lambda_um);
     ProgressBar bar("lightsim", !quiet && bench_runs == 0);
-    options.progress = bar.callback();
+    const ProgressFn progress = bar.callback();
+    auto runBands = [&] {
+      BandSum sum;
+      for (std::size_t b = 0; b < bands.size(); ++b) {
+        std::unique_ptr<Simulator> band_simulator;
+        if (!simulator || bands.size() > 1) {
+          const Volume band_volume = volumeAtWavelength(at_scale, bands[b].lambda_um);
+          band_simulator = makeSimulator(band_volume, choice, &options);
+          choice.report = nullptr;  // the back end's choice is said once
+        }
+        Simulator& sim = band_simulator ? *band_simulator : *simulator;
+        LightSpec band_light = light;
+        band_light.power *= bands[b].rgb;
+        SimulationOptions band_options = options;
+        if (progress)
+          band_options.progress = [&, b](double f) { progress((static_cast<double>(b) + f) / static_cast<double>(bands.size())); };
+        if (hooks.before) hooks.before(b, band_options);
+        BakeResult band = sim.run(band_light, band_options);
+        if (hooks.after) hooks.after(b, band);
+        if (b + 1 == bands.size() && band_simulator) simulator = std::move(band_simulator);  // for lastRunStats
+        sum.add(std::move(band));
+      }
+      return sum.finish();
+    };
     BakeResult result;
     std::vector<double> seconds;
     for (int run = 0; run < std::max(1, bench_runs); ++run) {
       const Stopwatch watch;
-      result = simulator->run(light, options);
+      result = runBands();
       seconds.push_back(watch.seconds());
       if (bench_runs > 0 && !quiet)
         std::fprintf(stderr, "lightsim: bench run %d of %d: %.3f s\n", run + 1, bench_runs, seconds.back());
@@ -274,12 +317,12 @@ int run(int argc, char** argv) {
     if (lightMissedVolume(result.stats))
       std::fprintf(stderr, "lightsim: warning: the light misses the volume; the bake is empty\n");
 
-    if (after_run) after_run(result);
     if (smooth_irradiance > 0.0) smoothIrradiance(result, volume.grid, smooth_irradiance);
     LightSpec baked_light = light;
     bakeToVolumeFrame(result, baked_light, scale);
     applyBake(volume, result, baked_light);
     volume.metadata["bake_options"] = bakeOptionsToJson(options);
+    if (bands.size() > 1) volume.metadata["bake_bands"] = bands.size();
     if (smooth_irradiance > 0.0) volume.metadata["irradiance_smoothing_sigma_voxels"] = smooth_irradiance;
     VolumeWriteOptions write;
     write.gzip = !raw;
@@ -366,7 +409,12 @@ int run(int argc, char** argv) {
       box.h = voxelEdge(grid);
       boxes.push_back(box);
     }
-    SceneLightChain chain(boxes, world_light, ground);
+    // A dispersive object anywhere: every object is baked band by band (what it hands on differs
+    // per band), a chain per band.
+    const bool dispersive = std::any_of(volumes.begin(), volumes.end(), [](const Volume& v) { return isDispersive(v); });
+    const std::vector<SpectralBand> bands = dispersive ? spectralBands(band_count) : spectralBands(1);
+    std::vector<SceneLightChain> chains(bands.size(), SceneLightChain(boxes, world_light, ground));
+    const SceneLightChain& chain = chains.front();
     fs::create_directories(out_dir);
     Scene baked = scene;
     for (std::size_t step = 0; step < volumes.size(); ++step) {
@@ -374,22 +422,34 @@ int run(int argc, char** argv) {
       const BakeFrame frame = BakeFrame::of(scene.objects[i]);
       SimulationOptions object_options = options;
       if (ground) object_options.receiver = frame.receiver(*ground);
-      chain.attach(i, object_options);
       if (!quiet) std::fprintf(stderr, "lightsim: [%zu/%zu] %s\n", step + 1, volumes.size(), sources[i].c_str());
+      BandHooks hooks;
+      hooks.before = [&](std::size_t band, SimulationOptions& o) { chains[band].attach(i, o); };
+      hooks.after = [&](std::size_t band, BakeResult& result) {
+        chains[band].correctMap(i, result);
+        if (band + 1 < bands.size() || quiet) return;
+        SceneLightChain::Exchange x;  // over the bands
+        for (const SceneLightChain& c : chains) {
+          const SceneLightChain::Exchange& e = c.exchange(i);
+          x.taken_in += e.taken_in;
+          x.left_out += e.left_out;
+          x.passed += e.passed;
+          x.flux_in += e.flux_in;
+          x.flux_left_out += e.flux_left_out;
+          x.flux_passed += e.flux_passed;
+        }
+        if (x.taken_in > 0)
+          std::fprintf(stderr, "lightsim: from the objects before it: %zu patches (%.4g W) taken in\n", x.taken_in,
+                       luminance(x.flux_in));
+        if (x.passed > 0)
+          std::fprintf(stderr, "lightsim: %zu patches (%.4g W) sent on too dim to follow: they pass unchanged\n",
+                       x.passed, luminance(x.flux_passed));
+        if (x.left_out > 0)
+          std::fprintf(stderr, "lightsim: %zu of the light's cells (%.4g W) in their shade\n", x.left_out,
+                       luminance(x.flux_left_out));
+      };
       bake(volumes[i], sources[i], frame.light(world_light), object_options, (out_dir / names[i]).string(), "",
-           frame.scale, [&](BakeResult& result) {
-             chain.correctMap(i, result);
-             const SceneLightChain::Exchange& x = chain.exchange(i);
-             if (!quiet && x.taken_in > 0)
-               std::fprintf(stderr, "lightsim: from the objects before it: %zu patches (%.4g W) taken in\n", x.taken_in,
-                            luminance(x.flux_in));
-             if (!quiet && x.passed > 0)
-               std::fprintf(stderr, "lightsim: %zu patches (%.4g W) sent on too dim to follow: they pass unchanged\n",
-                            x.passed, luminance(x.flux_passed));
-             if (!quiet && x.left_out > 0)
-               std::fprintf(stderr, "lightsim: %zu of the light's cells (%.4g W) in their shade\n", x.left_out,
-                            luminance(x.flux_left_out));
-           });
+           frame.scale, bands, hooks);
       volumes[i] = Volume();  // its memory for the next object's bake
       baked.objects[i].volume = names[i];
     }
@@ -425,7 +485,8 @@ int run(int argc, char** argv) {
   volume.require("ior", 1, input);
   volume.require("ior_grad", 3, input);
   interfaceTable(volume, input);  // a malformed table is named with the file, before any work
-  return bake(volume, input, light, options, output, stats_path, 1.0);
+  return bake(volume, input, light, options, output, stats_path, 1.0,
+              isDispersive(volume) ? spectralBands(band_count) : spectralBands(1));
 }
 
 }  // namespace
