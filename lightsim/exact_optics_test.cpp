@@ -129,16 +129,22 @@ struct PatchSize {
 
 SphereBake measureSphereBake(int res, const BakeResult& bake);
 
+// The patch size and depth `lightsim` takes for a volume with sharp interfaces on `grid` (volumeDefaults).
+SimulationOptions lightsimSharpOptions(const GridSpec& grid) {
+  SimulationOptions options;
+  const VolumeDefaults defaults = volumeDefaults(true, grid);
+  options.max_depth = defaults.max_depth;
+  options.patch_voxels = defaults.patch_voxels;
+  options.split_voxels = defaults.split_voxels;
+  return options;
+}
+
 SphereBake bakeSphereOnFloor(int res, Stepping stepping = Stepping::Flight, Backend backend = Backend::Cpu,
                              std::optional<PatchSize> patch_size = std::nullopt) {
   const Volume volume = sharpVolume("procedural:sphere,r=1,center=0:1.5:0,ior=1.5", res, std::nullopt, 2.0);
   const std::unique_ptr<Simulator> sim = simulatorFor(volume, backend);
   LightSpec light;  // straight down, irradiance 1
-  SimulationOptions options;
-  const VolumeDefaults defaults = volumeDefaults(true, volume.grid);  // lightsim's, with sharp interfaces
-  options.max_depth = defaults.max_depth;
-  options.patch_voxels = defaults.patch_voxels;
-  options.split_voxels = defaults.split_voxels;
+  SimulationOptions options = lightsimSharpOptions(volume.grid);
   if (patch_size) {
     options.patch_voxels = patch_size->patch_voxels;
     options.split_voxels = patch_size->split_voxels;
@@ -308,11 +314,7 @@ SphereBake bakePlacedSphereOnFloor(int res) {
   LightSpec sun;  // straight down in the world, irradiance 1
   ReceiverSpec floor;
   floor.half_extent = 1.6;
-  SimulationOptions options;
-  const VolumeDefaults defaults = volumeDefaults(true, at_world_scale.grid);
-  options.max_depth = defaults.max_depth;
-  options.patch_voxels = defaults.patch_voxels;
-  options.split_voxels = defaults.split_voxels;
+  SimulationOptions options = lightsimSharpOptions(at_world_scale.grid);
   options.receiver = frame.receiver(floor);
   LightSpec light = frame.light(sun);
   EXPECT_NEAR(glm::degrees(std::acos(-light.direction.y)), 20.0, 1e-9) << "the sun as the volume sees it";
@@ -387,11 +389,7 @@ StackedBake bakeStackedSpheres(int res, bool chained, double upper_ior = 1.5, Ba
   LightSpec sun;  // straight down, irradiance 1
   ReceiverSpec floor;
   floor.half_extent = 1.6;
-  SimulationOptions options;
-  const VolumeDefaults defaults = volumeDefaults(true, volume.grid);
-  options.max_depth = defaults.max_depth;
-  options.patch_voxels = defaults.patch_voxels;
-  options.split_voxels = defaults.split_voxels;
+  SimulationOptions options = lightsimSharpOptions(volume.grid);
   options.free_flight = true;
   options.straight_step_voxels = 2.0;
   options.volume_deposits = false;

@@ -429,15 +429,7 @@ int run(int argc, char** argv) {
         chains[band].correctMap(i, result);
         if (band + 1 < bands.size() || quiet) return;
         SceneLightChain::Exchange x;  // over the bands
-        for (const SceneLightChain& c : chains) {
-          const SceneLightChain::Exchange& e = c.exchange(i);
-          x.taken_in += e.taken_in;
-          x.left_out += e.left_out;
-          x.passed += e.passed;
-          x.flux_in += e.flux_in;
-          x.flux_left_out += e.flux_left_out;
-          x.flux_passed += e.flux_passed;
-        }
+        for (const SceneLightChain& c : chains) x += c.exchange(i);
         if (x.taken_in > 0)
           std::fprintf(stderr, "lightsim: from the objects before it: %zu patches (%.4g W) taken in\n", x.taken_in,
                        luminance(x.flux_in));

@@ -274,6 +274,16 @@ void SceneLightChain::attach(std::size_t k, SimulationOptions& options) {
   };
 }
 
+SceneLightChain::Exchange& SceneLightChain::Exchange::operator+=(const Exchange& o) {
+  taken_in += o.taken_in;
+  left_out += o.left_out;
+  passed += o.passed;
+  flux_in += o.flux_in;
+  flux_left_out += o.flux_left_out;
+  flux_passed += o.flux_passed;
+  return *this;
+}
+
 void SceneLightChain::correctMap(std::size_t k, BakeResult& result) {
   if (!result.receivers.empty()) {
     ReceiverMap& map = result.receivers.front();

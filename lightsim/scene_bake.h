@@ -89,6 +89,7 @@ class SceneLightChain {
   struct Exchange {
     std::size_t taken_in = 0, left_out = 0, passed = 0;  // passed: sent here, too dim to take in
     glm::dvec3 flux_in{0.0}, flux_left_out{0.0}, flux_passed{0.0};
+    Exchange& operator+=(const Exchange& o);  // over spectral bands
   };
   // A patch sent on whose irradiance is under this fraction of the light's brightest on the box
   // (wavefront.h brightestIrradiance) passes the box unchanged: where a wavefront that dim lights
