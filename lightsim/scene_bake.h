@@ -97,7 +97,7 @@ class SceneLightChain {
   // irradiance. Measured on the museum: at 10⁻³ the light the sphere and the logo block send
   // sideways reached the next objects as 6 700 patches (0.06 W in all, against some 10 W of sun
   // on them), which split and cost 1.5 M more patch-steps (+25 %); at 10⁻² 1 300 patches (0.05 W)
-  // are taken in and the scene costs 7 % more patch-steps than the four objects baked alone.
+  // are taken in and the scene costs 6 % more patch-steps than the four objects baked alone.
   static constexpr double kDimHandOn = 1e-2;
   const Exchange& exchange(std::size_t k) const { return exchange_[k]; }
 
