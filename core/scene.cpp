@@ -167,7 +167,7 @@ Scene sceneFromJson(const json& j, const std::string& source) {
       std::string path = "lights[" + std::to_string(i) + "]";
       ObjectReader r(lights[i], source, path,
                      {"type", "direction", "irradiance", "position", "intensity", "inner_cone_deg", "outer_cone_deg",
-                      "name"});
+                      "angular_diameter_deg", "name"});
       SceneLightSpec light;
       std::string type = r.string("type", "");
       if (type == "directional") {
@@ -176,6 +176,9 @@ Scene sceneFromJson(const json& j, const std::string& source) {
         light.irradiance = r.vec3("irradiance", light.irradiance);
         requireNonNegative(r, "irradiance", light.irradiance);
         requireLightPower(r, "irradiance", light.irradiance);
+        light.angular_diameter_deg = r.number("angular_diameter_deg", 0.0);
+        if (!(light.angular_diameter_deg >= 0.0 && light.angular_diameter_deg <= kMaxAngularDiameterDeg))
+          r.fail(path + ".angular_diameter_deg", "must be in [0, 20] degrees");
         if (r.has("position") || r.has("intensity")) r.fail(path, "a directional light takes direction and irradiance");
       } else if (type == "point") {
         light.type = SceneLightSpec::Type::Point;
@@ -206,6 +209,8 @@ Scene sceneFromJson(const json& j, const std::string& source) {
       }
       if (light.type != SceneLightSpec::Type::Spot && (r.has("inner_cone_deg") || r.has("outer_cone_deg")))
         r.fail(path, "only a spot light has a cone");
+      if (light.type != SceneLightSpec::Type::Directional && r.has("angular_diameter_deg"))
+        r.fail(path, "only a directional light has an angular diameter (a point or spot light is a point)");
       scene.lights.push_back(light);
     }
   }
@@ -289,17 +294,20 @@ json sceneToJson(const Scene& s) {
   j["environment"] = env;
   j["lights"] = json::array();
   for (const auto& l : s.lights) {
-    if (l.type == SceneLightSpec::Type::Directional)
-      j["lights"].push_back({{"type", "directional"}, {"direction", toJson(l.direction)}, {"irradiance", toJson(l.irradiance)}});
-    else if (l.type == SceneLightSpec::Type::Point)
+    if (l.type == SceneLightSpec::Type::Directional) {
+      json d = {{"type", "directional"}, {"direction", toJson(l.direction)}, {"irradiance", toJson(l.irradiance)}};
+      if (l.angular_diameter_deg > 0.0) d["angular_diameter_deg"] = l.angular_diameter_deg;
+      j["lights"].push_back(d);
+    } else if (l.type == SceneLightSpec::Type::Point) {
       j["lights"].push_back({{"type", "point"}, {"position", toJson(l.position)}, {"intensity", toJson(l.intensity)}});
-    else
+    } else {
       j["lights"].push_back({{"type", "spot"},
                              {"position", toJson(l.position)},
                              {"direction", toJson(l.direction)},
                              {"intensity", toJson(l.intensity)},
                              {"inner_cone_deg", l.inner_cone_deg},
                              {"outer_cone_deg", l.outer_cone_deg}});
+    }
   }
   if (s.ground)
     j["ground"] = {{"point", toJson(s.ground->point)},

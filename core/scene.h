@@ -30,7 +30,12 @@ struct SceneLightSpec {
   glm::dvec3 intensity{1.0};              // point, spot (on its axis): radiant intensity W/sr, RGB
   double inner_cone_deg = 0.0;            // spot: full intensity within this angle of the axis
   double outer_cone_deg = 45.0;           // spot: none beyond it (glTF KHR_lights_punctual's defaults)
+  // directional: the angle the light's disc spans (the sun's 0.53°; 0: a point at infinity, sharp
+  // shadows). Its irradiance comes evenly from the disc: soft shadows (lightsim/sun_disc.h).
+  double angular_diameter_deg = 0.0;
 };
+// The largest angular diameter a directional light may have (degrees).
+constexpr double kMaxAngularDiameterDeg = 20.0;
 
 // A spot light's intensity off its axis, as a fraction of the axis' (glTF KHR_lights_punctual):
 // ((cos θ − cos θ_outer)/(cos θ_inner − cos θ_outer))² clamped to [0, 1], θ the angle between the

@@ -132,5 +132,20 @@ TEST(Scene, ASpotLightRoundTripsWithItsCone) {
   EXPECT_NEAR(spotAttenuation(mid, ci, co), ((mid - co) / (ci - co)) * ((mid - co) / (ci - co)), 1e-15);
 }
 
+// The sun's angular size round-trips; only a directional light has one, within [0, 20]°.
+TEST(Scene, ASunsAngularDiameterRoundTrips) {
+  const Scene scene = sceneFromJson(nlohmann::json::parse(R"({"lights": [{"type": "directional",
+      "direction": [0, -1, 0], "irradiance": [3, 3, 3], "angular_diameter_deg": 0.53}]})"),
+                                    "test");
+  EXPECT_EQ(scene.lights.at(0).angular_diameter_deg, 0.53);
+  EXPECT_EQ(sceneFromJson(sceneToJson(scene), "back").lights.at(0).angular_diameter_deg, 0.53);
+  EXPECT_FALSE(sceneToJson(sceneFromJson(nlohmann::json::parse(R"({"lights": [{"type": "directional",
+      "direction": [0, -1, 0]}]})"), "test"))["lights"][0].contains("angular_diameter_deg"));
+  for (const char* bad : {R"({"lights": [{"type": "directional", "direction": [0, -1, 0], "angular_diameter_deg": -1}]})",
+                          R"({"lights": [{"type": "directional", "direction": [0, -1, 0], "angular_diameter_deg": 21}]})",
+                          R"({"lights": [{"type": "point", "position": [0, 1, 0], "angular_diameter_deg": 1}]})"})
+    EXPECT_THROW(sceneFromJson(nlohmann::json::parse(bad), "test"), InputError) << bad;
+}
+
 }  // namespace
 }  // namespace eik

@@ -43,8 +43,11 @@ std::vector<double> parseNumbers(const std::string& text, const std::string& sou
 }  // namespace
 
 nlohmann::json LightSpec::toJson() const {
-  if (type == Type::Directional)
-    return {{"type", "directional"}, {"direction", vec3Json(direction)}, {"irradiance", vec3Json(power)}};
+  if (type == Type::Directional) {
+    nlohmann::json j = {{"type", "directional"}, {"direction", vec3Json(direction)}, {"irradiance", vec3Json(power)}};
+    if (angular_diameter_deg > 0.0) j["angular_diameter_deg"] = angular_diameter_deg;
+    return j;
+  }
   if (type == Type::Spot)
     return {{"type", "spot"},
             {"position", vec3Json(position)},
@@ -304,6 +307,7 @@ LightSpec lightFromScene(const std::filesystem::path& file) {
     light.type = LightSpec::Type::Directional;
     light.direction = l.direction;
     light.power = l.irradiance;
+    light.angular_diameter_deg = l.angular_diameter_deg;
   } else {
     light.type = l.type == SceneLightSpec::Type::Spot ? LightSpec::Type::Spot : LightSpec::Type::Point;
     light.position = l.position;

@@ -598,7 +598,9 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   ReceiverMap receiver;
   std::optional<FootprintSums> receiver_flux;
   if (options.receiver) {
-    receiver = receiverGeometry(*options.receiver, light, grid, ctx.box_lo, ctx.box_hi);
+    receiver = options.receiver_geometry ? *options.receiver_geometry
+                                         : receiverGeometry(*options.receiver, light, grid, ctx.box_lo, ctx.box_hi);
+    receiver.irradiance.clear();
     receiver_flux.emplace(receiver);
     ctx.receiver = &receiver;
   }

@@ -292,7 +292,11 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   glm::dvec3 boxLo, boxHi;
   propagationBox(grid, options, boxLo, boxHi);
   ReceiverMap receiver;
-  if (options.receiver) receiver = receiverGeometry(*options.receiver, light, grid, boxLo, boxHi);
+  if (options.receiver) {
+    receiver = options.receiver_geometry ? *options.receiver_geometry
+                                         : receiverGeometry(*options.receiver, light, grid, boxLo, boxHi);
+    receiver.irradiance.clear();
+  }
   double fluxRef = 0.0;
   DirectCells direct;  // cells that go straight to the receiver's map: in closed form, not followed
   std::vector<Patch> initial = initialPatches(light, grid, sampler, options, &fluxRef,

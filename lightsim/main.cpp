@@ -29,8 +29,10 @@
 #include "core/volume.h"
 #include "lightsim/bake.h"
 #include "lightsim/make_simulator.h"
+#include "lightsim/receiver.h"
 #include "lightsim/scene_bake.h"
 #include "lightsim/spectral_bake.h"
+#include "lightsim/sun_disc.h"
 #include "lightsim/wavefront.h"
 
 namespace fs = std::filesystem;
@@ -69,6 +71,7 @@ int run(int argc, char** argv) {
   double options_receiver_pitch = 0.25;
   int bench_runs = 0;
   int band_count = 3;
+  int sun_samples = kDefaultSunSamples;
   double smooth_irradiance = 0.0;
   bool quiet = false, raw = false;
   CLI::App app{
@@ -97,6 +100,11 @@ int run(int argc, char** argv) {
   app.add_option("--receiver-pitch", options_receiver_pitch,
                  "texel edge of the receiver map in voxels of the volume (default 0.25)")
       ->check(CLI::Range(0.01, 8.0));
+  app.add_option("--sun-samples", sun_samples,
+                 "directions over the disc of a light with an angular size (a scene's directional light with "
+                 "angular_diameter_deg, the sun's 0.53): its soft shadows in that many steps, at that many times "
+                 "the cost (default 16)")
+      ->check(CLI::Range(1, 256));
   app.add_option("--bands", band_count,
                  "spectral bands of a dispersive volume (a dispersion field or a slot with a Cauchy B), each "
                  "propagated with its own n(lambda): 3 (default: R, G, B at the viewer's 0.61, 0.55, 0.465 um), 1 "
@@ -205,15 +213,18 @@ int run(int argc, char** argv) {
   options.free_flight = free_flight == "on";
   // Bakes `volume` (read from `source`) with `light` and writes it to `out` (and the stats to
   // `stats_file`): the whole of a volume's bake, and one object's of a scene's. `scale` is the
-  // object's (scene_bake.h); light and receiver are given in its bake frame.
-  // What a scene's bake does around each spectral band's run of one object (its chain per band).
-  struct BandHooks {
-    std::function<void(std::size_t band, SimulationOptions&)> before;
-    std::function<void(std::size_t band, BakeResult&)> after;
+  // object's (scene_bake.h); light and receiver are given in its bake frame. A bake is one run or
+  // several, summed: each spectral band (spectral_bake.h) for each of `sun`, the light's
+  // directions over its disc (sun_disc.h; the light itself when it has no angular size), run
+  // number band × sun.size() + direction.
+  // What a scene's bake does around each run of one object (its chain per run).
+  struct RunHooks {
+    std::function<void(std::size_t run, SimulationOptions&)> before;
+    std::function<void(std::size_t run, BakeResult&)> after;
   };
-  auto bake = [&](Volume& volume, const std::string& source, const LightSpec& light, SimulationOptions options,
-                  const std::string& out, const std::string& stats_file, double scale,
-                  const std::vector<SpectralBand>& bands, const BandHooks& hooks = {}) {
+  auto bake = [&](Volume& volume, const std::string& source, const LightSpec& light, const std::vector<LightSpec>& sun,
+                  SimulationOptions options, const std::string& out, const std::string& stats_file, double scale,
+                  const std::vector<SpectralBand>& bands, const RunHooks& hooks = {}) {
     const std::string& output = out;
     const std::string& stats_path = stats_file;
     const VolumeDefaults defaults = volumeDefaults(volume.has("interfaces"), volume.grid);
@@ -255,8 +266,20 @@ int run(int argc, char** argv) {
     if (bands.size() > 1 && !quiet)
       std::fprintf(stderr, "lightsim: dispersive: %zu spectral bands, %.3f to %.3f um, each with its own n(lambda)\n",
                    bands.size(), bands.front().lambda_um, bands.back().lambda_um);
+    if (sun.size() > 1 && !quiet)
+      std::fprintf(stderr, "lightsim: the light's disc of %.3g degrees from %zu directions (soft shadows)\n",
+                   light.angular_diameter_deg, sun.size());
+    // Runs that are summed share one map lattice: the light's own.
+    if (options.receiver && bands.size() * sun.size() > 1) {
+      glm::dvec3 lo, hi;
+      propagationBox(at_scale.grid, options, lo, hi);
+      LightSpec point_like = light;
+      point_like.angular_diameter_deg = 0.0;
+      options.receiver_geometry = receiverGeometry(*options.receiver, point_like, at_scale.grid, lo, hi);
+    }
     ProgressBar bar("lightsim", !quiet && bench_runs == 0);
     const ProgressFn progress = bar.callback();
+    const std::size_t runs = bands.size() * sun.size();
     auto runBands = [&] {
       BandSum sum;
       for (std::size_t b = 0; b < bands.size(); ++b) {
@@ -267,16 +290,19 @@ int run(int argc, char** argv) {
           choice.report = nullptr;  // the back end's choice is said once
         }
         Simulator& sim = band_simulator ? *band_simulator : *simulator;
-        LightSpec band_light = light;
-        band_light.power *= bands[b].rgb;
-        SimulationOptions band_options = options;
-        if (progress)
-          band_options.progress = [&, b](double f) { progress((static_cast<double>(b) + f) / static_cast<double>(bands.size())); };
-        if (hooks.before) hooks.before(b, band_options);
-        BakeResult band = sim.run(band_light, band_options);
-        if (hooks.after) hooks.after(b, band);
+        for (std::size_t d = 0; d < sun.size(); ++d) {
+          const std::size_t r = b * sun.size() + d;
+          LightSpec run_light = sun[d];
+          run_light.power *= bands[b].rgb;
+          SimulationOptions run_options = options;
+          if (progress)
+            run_options.progress = [&, r](double f) { progress((static_cast<double>(r) + f) / static_cast<double>(runs)); };
+          if (hooks.before) hooks.before(r, run_options);
+          BakeResult one = sim.run(run_light, run_options);
+          if (hooks.after) hooks.after(r, one);
+          sum.add(std::move(one));
+        }
         if (b + 1 == bands.size() && band_simulator) simulator = std::move(band_simulator);  // for lastRunStats
-        sum.add(std::move(band));
       }
       return sum.finish();
     };
@@ -413,7 +439,12 @@ int run(int argc, char** argv) {
     // per band), a chain per band.
     const bool dispersive = std::any_of(volumes.begin(), volumes.end(), [](const Volume& v) { return isDispersive(v); });
     const std::vector<SpectralBand> bands = dispersive ? spectralBands(band_count) : spectralBands(1);
-    std::vector<SceneLightChain> chains(bands.size(), SceneLightChain(boxes, world_light, ground));
+    // A chain per run (band × direction of the light's disc), every one in the same order: the
+    // light's own.
+    const std::vector<LightSpec> world_sun = sunDiscSamples(world_light, sun_samples);
+    std::vector<SceneLightChain> chains;
+    for (std::size_t b = 0; b < bands.size(); ++b)
+      for (const LightSpec& direction : world_sun) chains.emplace_back(boxes, direction, ground, world_light);
     const SceneLightChain& chain = chains.front();
     fs::create_directories(out_dir);
     Scene baked = scene;
@@ -423,11 +454,11 @@ int run(int argc, char** argv) {
       SimulationOptions object_options = options;
       if (ground) object_options.receiver = frame.receiver(*ground);
       if (!quiet) std::fprintf(stderr, "lightsim: [%zu/%zu] %s\n", step + 1, volumes.size(), sources[i].c_str());
-      BandHooks hooks;
-      hooks.before = [&](std::size_t band, SimulationOptions& o) { chains[band].attach(i, o); };
-      hooks.after = [&](std::size_t band, BakeResult& result) {
-        chains[band].correctMap(i, result);
-        if (band + 1 < bands.size() || quiet) return;
+      RunHooks hooks;
+      hooks.before = [&](std::size_t run, SimulationOptions& o) { chains[run].attach(i, o); };
+      hooks.after = [&](std::size_t run, BakeResult& result) {
+        chains[run].correctMap(i, result);
+        if (run + 1 < chains.size() || quiet) return;
         SceneLightChain::Exchange x;  // over the bands
         for (const SceneLightChain& c : chains) x += c.exchange(i);
         if (x.taken_in > 0)
@@ -440,7 +471,9 @@ int run(int argc, char** argv) {
           std::fprintf(stderr, "lightsim: %zu of the light's cells (%.4g W) in their shade\n", x.left_out,
                        luminance(x.flux_left_out));
       };
-      bake(volumes[i], sources[i], frame.light(world_light), object_options, (out_dir / names[i]).string(), "",
+      std::vector<LightSpec> sun;
+      for (const LightSpec& direction : world_sun) sun.push_back(frame.light(direction));
+      bake(volumes[i], sources[i], frame.light(world_light), sun, object_options, (out_dir / names[i]).string(), "",
            frame.scale, bands, hooks);
       volumes[i] = Volume();  // its memory for the next object's bake
       baked.objects[i].volume = names[i];
@@ -477,7 +510,7 @@ int run(int argc, char** argv) {
   volume.require("ior", 1, input);
   volume.require("ior_grad", 3, input);
   interfaceTable(volume, input);  // a malformed table is named with the file, before any work
-  return bake(volume, input, light, options, output, stats_path, 1.0,
+  return bake(volume, input, light, sunDiscSamples(light, sun_samples), options, output, stats_path, 1.0,
               isDispersive(volume) ? spectralBands(band_count) : spectralBands(1));
 }
 

@@ -94,18 +94,19 @@ glm::dvec3 worldCorner(const SceneLightChain::Object& o, int k) {
 }  // namespace
 
 SceneLightChain::SceneLightChain(std::vector<Object> objects, const LightSpec& world_light,
-                                 std::optional<ReceiverSpec> ground)
+                                 std::optional<ReceiverSpec> ground, std::optional<LightSpec> order_light)
     : objects_(std::move(objects)), light_(world_light), ground_(std::move(ground)) {
+  const LightSpec& by = order_light ? *order_light : light_;
   const std::size_t n = objects_.size();
   std::vector<double> key(n, 0.0);
   for (std::size_t k = 0; k < n; ++k) {
     const Object& o = objects_[k];
-    if (light_.type == LightSpec::Type::Directional) {
-      const glm::dvec3 L = glm::normalize(light_.direction);
+    if (by.type == LightSpec::Type::Directional) {
+      const glm::dvec3 L = glm::normalize(by.direction);
       key[k] = kInf;
       for (int c = 0; c < 8; ++c) key[k] = std::min(key[k], glm::dot(worldCorner(o, c), L));
     } else {
-      const glm::dvec3 p = glm::transpose(o.frame.rotation) * (light_.position - o.frame.origin);
+      const glm::dvec3 p = glm::transpose(o.frame.rotation) * (by.position - o.frame.origin);
       key[k] = glm::length(p - glm::clamp(p, o.lo, o.hi));
     }
   }

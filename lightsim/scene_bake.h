@@ -69,8 +69,10 @@ class SceneLightChain {
     glm::dvec3 lo{0.0}, hi{0.0};  // its propagation box (wavefront.h propagationBox) in its bake frame
     double h = 0.0;               // its voxel edge at world scale
   };
-  // `world_light` and `ground` (nullopt: none) in the world.
-  SceneLightChain(std::vector<Object> objects, const LightSpec& world_light, std::optional<ReceiverSpec> ground);
+  // `world_light` and `ground` (nullopt: none) in the world; the order is the one `order_light`
+  // (default: world_light) meets the boxes in (a soft sun's directions share the sun's order).
+  SceneLightChain(std::vector<Object> objects, const LightSpec& world_light, std::optional<ReceiverSpec> ground,
+                  std::optional<LightSpec> order_light = std::nullopt);
 
   // The objects in the order they are baked (indices into the constructor's list).
   const std::vector<std::size_t>& order() const { return order_; }

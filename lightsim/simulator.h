@@ -36,6 +36,9 @@ struct LightSpec {
   // (W/sr, RGB); spot: on its axis. docs/programs.md --power.
   glm::dvec3 power{1.0};
   double inner_cone_deg = 0.0, outer_cone_deg = 45.0;  // spot: its cone (core/scene.h spotAttenuation)
+  // Directional: the disc's angular diameter (soft shadows). A run takes the light as a point at
+  // infinity; a bake samples the disc (lightsim/sun_disc.h) and sums the runs.
+  double angular_diameter_deg = 0.0;
   nlohmann::json toJson() const;         // as a SCENE.json light
   // The fraction of `power` a point or spot light sends along the unit direction `dir` (1 but off
   // a spot's axis).
@@ -69,6 +72,10 @@ struct SimulationOptions {
   DepositMode deposit = DepositMode::Accumulate;
   DepositKernel deposit_kernel = DepositKernel::Track;
   std::optional<ReceiverSpec> receiver;  // the plane that stops the light and gets a map
+  // The receiver map's lattice (receiver.h ReceiverMap without irradiance) instead of the one
+  // receiverGeometry makes for this light: runs whose maps are summed (a soft sun's directions,
+  // spectral bands) share one lattice.
+  std::optional<ReceiverMap> receiver_geometry;
   // A directional light's light that meets the receiver's map without meeting the box is put on
   // the map in closed form (directMapLight, receiver.h) instead of as patches that go straight
   // to it; the map is the same to rounding. Off: every such cell is a patch (the tests' reference).

@@ -128,7 +128,9 @@ TEST(SpectralBake, APrismBendsEachBandAsSnellsLawWithCauchy) {
     std::printf("%.4f um: n %.4f, deviation %.3f deg (exact %.3f), %.4f W\n", band.lambda_um, n, baked, exact, flux);
     EXPECT_NEAR(baked, exact, 0.1) << band.lambda_um;
     // The bands run from violet to red, and red is bent least: the deviation falls band by band.
-    if (&band != &bands.front()) EXPECT_LT(baked, previous - 0.2);
+    if (&band != &bands.front()) {
+      EXPECT_LT(baked, previous - 0.2);
+    }
     previous = baked;
     // The band's ledger closes.
     EXPECT_LT(r.stats.ledgerResidual(), 1e-9);

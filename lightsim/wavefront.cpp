@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "core/parallel.h"
+#include "core/scene.h"
 
 namespace eik {
 
@@ -686,6 +687,8 @@ void validateLight(const LightSpec& light) {
   } else if (!finite3(light.position)) {
     throw InputError("light", "position", "must be finite");
   }
+  if (!(light.angular_diameter_deg >= 0.0 && light.angular_diameter_deg <= kMaxAngularDiameterDeg))
+    throw InputError("light", "angular_diameter_deg", "must be in [0, 20] degrees");
   if (light.type == LightSpec::Type::Spot) {
     if (!finite3(light.direction) || glm::length(light.direction) == 0.0)
       throw InputError("light", "direction", "a spot light's axis must be a finite, non-zero vector");

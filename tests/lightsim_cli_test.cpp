@@ -398,6 +398,29 @@ TEST(LightsimCli, BakesADispersiveVolumeBandByBand) {
   }
 }
 
+// A scene's sun with an angular size: the bake follows --sun-samples directions over its disc
+// (sun_disc.h; the penumbra against geometry is ExactOpticsSoftSun), the baked manifest records
+// the light with its size, and the viewer renders it (drawing the map's penumbra as baked, without
+// sharpening the edge). The same scene without the size bakes once.
+TEST(LightsimCli, ASunWithADiscBakesSoftShadows) {
+  TempDir dir;
+  makeSphere(dir, true);
+  for (const bool disc : {true, false}) {
+    writeFile(dir / "SCENE.json", std::string(R"({
+      "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": [1, 1, 1])") +
+                                     (disc ? R"(, "angular_diameter_deg": 5)" : "") + R"(}],
+      "ground": {"point": [0, -0.6, 0], "normal": [0, 1, 0], "half_extent": 2},
+      "objects": [{"volume": "sharp.vol.json"}]})");
+    ProgramResult r = runProgram(LIGHTSIM_EXE, {"SCENE.json", "-o", "out", "--sun-samples", "6"}, dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(r.output.find("from 6 directions (soft shadows)") != std::string::npos, disc) << r.output;
+    const Volume baked = readVolume(dir / "out" / "sharp.baked.vol.json");
+    EXPECT_EQ(baked.metadata["light"].value("angular_diameter_deg", 0.0), disc ? 5.0 : 0.0);
+    ProgramResult v = runProgram(VIEWER_EXE, {"out/SCENE.json", "--render", "soft.png", "--size", "48x32"}, dir.path());
+    EXPECT_EQ(v.exit_code, 0) << v.output;
+  }
+}
+
 // Ctrl-C (SIGINT) or a kill (SIGTERM) during a bake: exit 130 / 143, a message, and no output file
 // or temporary left (core/interrupt.h). The bake repeats (--bench); the signal is sent once the first
 // repetition has reported, so it finds the program at work whatever the machine's load.

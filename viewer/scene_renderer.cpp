@@ -80,6 +80,7 @@ struct SceneRenderer::Impl {
     glm::vec3 light_power{0.0f};
     glm::vec4 light_spot{0.0f};  // a spot light's axis and cos θ_outer (ReceiverLayer)
     float light_spot_scale = 0.0f;
+    bool light_disc = false;  // a directional light with an angular size: the map's soft shadow as baked
   };
   static GroundReceiver findGroundReceiver(const LoadedObject& loaded, const SceneGroundSpec& ground) {
     const glm::dmat4 to_volume = glm::inverse(loaded.object_to_world);
@@ -98,6 +99,7 @@ struct SceneRenderer::Impl {
       found.map = &map;
       try {
         if (light.at("type") == "directional") {
+          found.light_disc = light.value("angular_diameter_deg", 0.0) > 0.0;
           found.light_pos = glm::vec4(glm::normalize(vec3Of("direction")), 0.0f);
           found.light_power = vec3Of("irradiance");
         } else {
@@ -119,7 +121,8 @@ struct SceneRenderer::Impl {
   }
 
   // The receiver texture's texels: the map with its shadow's edge to the pixel (shadow_edge.h:
-  // directional light, sharp interfaces). No GL: SceneRenderer::prepare runs it before a context.
+  // directional light without an angular size, sharp interfaces; a light's disc makes the edge a
+  // penumbra, which the map holds as baked). No GL: SceneRenderer::prepare runs it before a context.
   static std::vector<float> groundTexels(const LoadedObject& loaded, const GroundReceiver& found) {
     const glm::dmat4 to_volume = glm::inverse(loaded.object_to_world);
     ReceiverLayer layer{found.map,
@@ -130,7 +133,7 @@ struct SceneRenderer::Impl {
                         glm::dvec4(found.light_spot),
                         found.light_spot_scale};
     const std::vector<float> clearance =
-        found.light_pos.w == 0.0f ? shadowClearance(loaded.volume, *found.map, glm::dvec3(found.light_pos))
+        found.light_pos.w == 0.0f && !found.light_disc ? shadowClearance(loaded.volume, *found.map, glm::dvec3(found.light_pos))
                                   : std::vector<float>();
     return receiverTexels(layer, clearance);
   }
