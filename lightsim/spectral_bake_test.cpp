@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -87,11 +88,11 @@ bool refract(const glm::dvec3& d, const glm::dvec3& n, double n1, double n2, glm
 // (∓cos 30°, 0, −sin 30°)) in a sun that meets face AC at the minimum-deviation angle for n_d
 // (inside, the ray runs parallel to the base). Each band's light leaves through face AB; its mean
 // direction (flux-weighted over the patches that leave within 3° of the exact direction) against
-// the exact refraction at the two faces with that band's n(λ). Tolerance 0.1° (the issue's): the
-// faces are planes, so the bake's error is the voxelised normal's (sharp interfaces: a small
-// fraction of a degree where the faces meet) and the patches' own spread.
-TEST(SpectralBake, APrismBendsEachBandAsSnellsLawWithCauchy) {
-  const Volume volume = sharpVolume("procedural:prism,side=0.5,height=0.4,ior=1.75,abbe=20", 32);
+// the exact refraction at the two faces with that band's n(λ). The faces are planes, so the bake's
+// error is the voxelised normals' (sharp interfaces: a fraction of a degree) and the patches' own
+// spread. Returns the worst band's deviation from the exact angle (degrees); each band within `bound`.
+double expectPrismBendsEachBandAsSnellsLaw(int res, double bound) {
+  const Volume volume = sharpVolume("procedural:prism,side=0.5,height=0.4,ior=1.75,abbe=20", res);
   const double b = interfaceTable(volume).slots.at(0).dispersion_b;
   const glm::dvec3 n_ac(-std::cos(M_PI / 6), 0.0, -0.5), n_ab(std::cos(M_PI / 6), 0.0, -0.5);
   // Minimum deviation for n_d: the incident ray makes θ₁ = asin(n_d sin 30°) with the inward normal of AC.
@@ -106,12 +107,14 @@ TEST(SpectralBake, APrismBendsEachBandAsSnellsLawWithCauchy) {
   options.straight_step_voxels = 2.0;
   options.bounces = 0;
   const std::vector<SpectralBand> bands = spectralBands(7);
-  double previous = 0.0;
+  double previous = 0.0, worst = 0.0;
   for (const SpectralBand& band : bands) {
     const double n = 1.75 + b * cauchyTerm(band.lambda_um);
     glm::dvec3 inside, out;
-    ASSERT_TRUE(refract(sun, n_ac, 1.0, n, inside));
-    ASSERT_TRUE(refract(inside, -n_ab, n, 1.0, out));
+    if (!refract(sun, n_ac, 1.0, n, inside) || !refract(inside, -n_ab, n, 1.0, out)) {
+      ADD_FAILURE() << "no exact path through the prism at " << band.lambda_um;
+      return 180.0;
+    }
     const double exact = glm::degrees(std::acos(glm::dot(sun, out)));
     glm::dvec3 sum(0.0);
     double flux = 0.0;
@@ -123,10 +126,15 @@ TEST(SpectralBake, APrismBendsEachBandAsSnellsLawWithCauchy) {
     };
     CpuSimulator sim(volumeAtWavelength(volume, band.lambda_um));
     const BakeResult r = sim.run(light, options);
-    ASSERT_GT(flux, 0.0);
+    if (!(flux > 0.0)) {
+      ADD_FAILURE() << "no light left the prism near the exact direction at " << band.lambda_um;
+      return 180.0;
+    }
     const double baked = glm::degrees(std::acos(glm::dot(sun, glm::normalize(sum))));
-    std::printf("%.4f um: n %.4f, deviation %.3f deg (exact %.3f), %.4f W\n", band.lambda_um, n, baked, exact, flux);
-    EXPECT_NEAR(baked, exact, 0.1) << band.lambda_um;
+    std::printf("%d³, %.4f um: n %.4f, deviation %.3f deg (exact %.3f), %.4f W\n", res, band.lambda_um, n, baked, exact,
+                flux);
+    EXPECT_NEAR(baked, exact, bound) << res << "³, " << band.lambda_um << " um";
+    worst = std::max(worst, std::abs(baked - exact));
     // The bands run from violet to red, and red is bent least: the deviation falls band by band.
     if (&band != &bands.front()) {
       EXPECT_LT(baked, previous - 0.2);
@@ -135,6 +143,16 @@ TEST(SpectralBake, APrismBendsEachBandAsSnellsLawWithCauchy) {
     // The band's ledger closes.
     EXPECT_LT(r.stats.ledgerResidual(), 1e-9);
   }
+  return worst;
+}
+
+// At two resolutions: the 0.1° at 32³ (measured worst 0.025°), and converging from 24³
+// (measured worst 0.13°, the blue band, where the prism's faces are 10 voxels wide and their
+// voxelised normals tilt most; bound 0.2° there).
+TEST(SpectralBake, APrismBendsEachBandAsSnellsLawWithCauchy) {
+  const double coarse = expectPrismBendsEachBandAsSnellsLaw(24, 0.2);
+  const double fine = expectPrismBendsEachBandAsSnellsLaw(32, 0.1);
+  EXPECT_LT(fine, coarse);
 }
 
 }  // namespace
