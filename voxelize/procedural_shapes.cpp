@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/scene.h"
 #include "voxelize/distance_functions.h"
 
 namespace eik {
@@ -37,6 +38,38 @@ ImplicitSolid solid(std::string name, Material m, std::function<double(const dve
 // Region name: the material's name if the user gave one, else the shape's default.
 std::string regionName(const ShapeParams& p, const std::string& fallback, const Material& m) {
   return p.given("name") ? m.name : fallback;
+}
+
+// The keys every shape but the floor takes after its own: a uniform scale and a turn about the
+// shape's centre, as a scene places a volume (docs/scene-format.md: X, then Y, then Z).
+std::vector<ParamDef> placed(std::vector<ParamDef> params) {
+  params.push_back(positiveParam("scale", "1", "scale about the centre (σa stays per world unit, as a scene's scale)"));
+  params.push_back(tripleParam("euler_deg", "0:0:0", -1e300, false,
+                               "turn about the centre: degrees about X, then Y, then Z (a scene's rotate_deg)"));
+  return params;
+}
+
+// The solids scaled by s and turned by R about c: x = c + R·s·(x_shape − c). A signed distance
+// scales by s and keeps under a turn; the bounds are those of the turned box's corners.
+void place(std::vector<ImplicitSolid>& solids, const dvec3& c, double s, const dvec3& euler_deg) {
+  if (s == 1.0 && euler_deg == dvec3(0.0)) return;
+  SceneObjectSpec placement;
+  placement.rotate_deg = euler_deg;
+  placement.scale = s;
+  const glm::dmat3 to_world(objectToWorld(placement));
+  const glm::dmat3 to_shape = glm::inverse(to_world);
+  for (ImplicitSolid& solid : solids) {
+    const auto back = [=](const dvec3& x) { return c + to_shape * (x - c); };
+    solid.sdf = [sdf = std::move(solid.sdf), back, s](const dvec3& x) { return s * sdf(back(x)); };
+    if (solid.ior) solid.ior = [ior = std::move(solid.ior), back](const dvec3& x) { return ior(back(x)); };
+    Bounds turned;
+    for (int k = 0; k < 8; ++k) {
+      const dvec3 corner((k & 1) ? solid.bounds.max.x : solid.bounds.min.x, (k & 2) ? solid.bounds.max.y : solid.bounds.min.y,
+                         (k & 4) ? solid.bounds.max.z : solid.bounds.min.z);
+      turned.extend(c + to_world * (corner - c));
+    }
+    solid.bounds = turned;
+  }
 }
 
 std::vector<ImplicitSolid> buildSphere(const ShapeParams& p, double) {
@@ -370,6 +403,8 @@ const std::vector<ShapeDef>& shapeDefs() {
                   positiveParam("size", "2", "side length of the square"),
                   numberParam("thickness", "0", 0.0, 1e300, false, "thickness below y (0: one voxel of the grid)")},
                  {"albedo", "name"}, {"floor"}, buildFloor});
+    for (ShapeDef& def : d)
+      if (def.name != "floor") def.params = placed(std::move(def.params));
     return d;
   }();
   return defs;
@@ -390,7 +425,9 @@ std::string shapeNames() {
 std::vector<ImplicitSolid> buildShapeSolids(const ProceduralSpec& spec, double voxel_height) {
   const ShapeDef& shape = findShape(spec.name, kProceduralPrefix + spec.name);
   const ShapeParams params(shape.name, shape.params, shape.material_keys, spec);
-  return shape.build(params, voxel_height);
+  std::vector<ImplicitSolid> solids = shape.build(params, voxel_height);
+  if (params.has("scale")) place(solids, params.vec("center"), params.number("scale"), params.vec("euler_deg"));
+  return solids;
 }
 
 }  // namespace eik

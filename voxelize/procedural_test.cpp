@@ -42,7 +42,7 @@ TEST(ProceduralSpec, Errors) {
 
   e = specErrorOf("procedural:sphere,radius=1");
   EXPECT_NE(e.find("procedural:sphere: radius: unknown key"), std::string::npos) << e;
-  EXPECT_NE(e.find("valid keys: r, center, ior"), std::string::npos) << e;
+  EXPECT_NE(e.find("valid keys: r, center, scale, euler_deg, ior"), std::string::npos) << e;
 
   e = specErrorOf("procedural:sphere,r=big");
   EXPECT_NE(e.find("r: 'big' is not a number"), std::string::npos) << e;

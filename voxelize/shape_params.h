@@ -63,6 +63,8 @@ class ShapeParams {
   double number(const std::string& key) const;
   glm::dvec3 vec(const std::string& key) const;
   std::string text(const std::string& key) const { return values_.at(key); }
+  // Whether the shape takes `key` (given or defaulted).
+  bool has(const std::string& key) const { return values_.count(key) > 0; }
   // Whether the user gave `key` (a shape key or a material key).
   bool given(const std::string& key) const;
   // The Cauchy B for index n if the user gave `abbe`, else `fallback` (for shapes whose n is not the
