@@ -128,7 +128,16 @@ void applyBake(Volume& volume, const BakeResult& result, const LightSpec& light)
   }
   volume.receivers = result.receivers;
   volume.metadata["light"] = light.toJson();
+  volume.metadata.erase("lights");
   volume.metadata["bake_stats"] = result.stats.toJson();
+}
+
+void applyBake(Volume& volume, const BakeResult& result, const std::vector<LightSpec>& lights) {
+  applyBake(volume, result, lights.at(0));
+  if (lights.size() < 2) return;
+  nlohmann::json all = nlohmann::json::array();
+  for (const LightSpec& light : lights) all.push_back(light.toJson());
+  volume.metadata["lights"] = all;
 }
 
 bool viewerReadsVolumeLight(const Volume& volume, bool receiver_map) {
@@ -298,28 +307,34 @@ LightSpec parseLight(const std::string& light_text, const std::string& power_tex
   return light;
 }
 
-LightSpec lightFromScene(const std::filesystem::path& file) {
+std::vector<LightSpec> lightsFromScene(const std::filesystem::path& file) {
   Scene scene = readScene(file);
   if (scene.lights.empty()) throw InputError(file.string(), "lights", "the scene has no light to bake");
-  const SceneLightSpec& l = scene.lights.front();
-  LightSpec light;
-  if (l.type == SceneLightSpec::Type::Directional) {
-    light.type = LightSpec::Type::Directional;
-    light.direction = l.direction;
-    light.power = l.irradiance;
-    light.angular_diameter_deg = l.angular_diameter_deg;
-  } else {
-    light.type = l.type == SceneLightSpec::Type::Spot ? LightSpec::Type::Spot : LightSpec::Type::Point;
-    light.position = l.position;
-    light.power = l.intensity;
-    light.direction = l.direction;
-    light.inner_cone_deg = l.inner_cone_deg;
-    light.outer_cone_deg = l.outer_cone_deg;
+  std::vector<LightSpec> lights;
+  for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+    const SceneLightSpec& l = scene.lights[i];
+    LightSpec light;
+    if (l.type == SceneLightSpec::Type::Directional) {
+      light.type = LightSpec::Type::Directional;
+      light.direction = l.direction;
+      light.power = l.irradiance;
+      light.angular_diameter_deg = l.angular_diameter_deg;
+    } else {
+      light.type = l.type == SceneLightSpec::Type::Spot ? LightSpec::Type::Spot : LightSpec::Type::Point;
+      light.position = l.position;
+      light.power = l.intensity;
+      light.direction = l.direction;
+      light.inner_cone_deg = l.inner_cone_deg;
+      light.outer_cone_deg = l.outer_cone_deg;
+    }
+    if (!(light.power.x > 0 || light.power.y > 0 || light.power.z > 0))
+      throw InputError(file.string(), "lights[" + std::to_string(i) + "]", "the light has no power");
+    lights.push_back(light);
   }
-  if (!(light.power.x > 0 || light.power.y > 0 || light.power.z > 0))
-    throw InputError(file.string(), "lights[0]", "the light has no power");
-  return light;
+  return lights;
 }
+
+LightSpec lightFromScene(const std::filesystem::path& file) { return lightsFromScene(file).front(); }
 
 ReceiverSpec parseReceiver(const std::string& text) {
   ReceiverSpec spec;

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <vector>
 #include <string>
 
 #include "core/volume.h"
@@ -16,6 +17,10 @@ namespace eik {
 // (SimulationStats::toJson). Throws std::invalid_argument when the result's fields do not fit the
 // volume's grid (3 components, one per voxel).
 void applyBake(Volume& volume, const BakeResult& result, const LightSpec& light);
+// The same for a bake of several lights summed (a scene's): "light" the first, whose direct light
+// a receiver map's reader takes off exactly, and "lights" all of them in order (only when there are
+// two or more; a one-light bake removes an earlier bake's list).
+void applyBake(Volume& volume, const BakeResult& result, const std::vector<LightSpec>& lights);
 
 // Whether the viewer reads a bake's volume fields (irradiance, light_dir) for this volume: it does
 // for in-scattering (a `scatter` field with a non-zero albedo somewhere), for opaque embeddings (an
@@ -44,8 +49,11 @@ void smoothIrradiance(BakeResult& result, const GridSpec& grid, double sigma_vox
 // that is zero in every channel.
 LightSpec parseLight(const std::string& light, const std::string& power = "1,1,1");
 
-// The first light of a SCENE.json (`lightsim --scene`), as a LightSpec. Throws InputError naming
-// the file for a scene without lights or a light without power (and what readScene throws).
+// Every light of a SCENE.json, in its order, as LightSpecs (`lightsim SCENE.json`, `--scene`).
+// Throws InputError naming the file for a scene without lights or a light without power (and what
+// readScene throws).
+std::vector<LightSpec> lightsFromScene(const std::filesystem::path& file);
+// The first of them.
 LightSpec lightFromScene(const std::filesystem::path& file);
 
 // Parses `--receiver` ("PX,PY,PZ:NX,NY,NZ[:HALF_EXTENT]"): the plane through P with normal N

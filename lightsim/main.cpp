@@ -211,22 +211,38 @@ int run(int argc, char** argv) {
                                              : Integrator::Euler;
   options.deposit_kernel = kernel == "point" ? DepositKernel::Point : DepositKernel::Track;
   options.free_flight = free_flight == "on";
-  // Bakes `volume` (read from `source`) with `light` and writes it to `out` (and the stats to
-  // `stats_file`): the whole of a volume's bake, and one object's of a scene's. `scale` is the
-  // object's (scene_bake.h); light and receiver are given in its bake frame. A bake is one run or
-  // several, summed: each spectral band (spectral_bake.h) for each of `sun`, the light's
-  // directions over its disc (sun_disc.h; the light itself when it has no angular size), run
-  // number band × sun.size() + direction.
-  // What a scene's bake does around each run of one object (its chain per run).
+  // A bake of one volume (the whole of a volume's bake, or one object's of a scene) in three parts:
+  // `prepare` (lightsim's defaults for the volume, the volume at world scale, the back end, one map
+  // lattice for every run), `runLight` (one light: each spectral band (spectral_bake.h) for each of
+  // its directions over its disc (sun_disc.h; the light itself when it has no angular size), run
+  // number band × directions + direction, summed) and `write` (the lights' sums into the volume and
+  // its manifest). `scale` is the object's (scene_bake.h); lights and receiver are given in its bake
+  // frame.
+  struct BakeLight {
+    LightSpec light;                     // as the scene or the command line gives it
+    std::vector<LightSpec> directions;   // what is run: sunDiscSamples(light)
+  };
+  // What a scene's bake does around each run of one object under one light (its chain per run).
   struct RunHooks {
     std::function<void(std::size_t run, SimulationOptions&)> before;
     std::function<void(std::size_t run, BakeResult&)> after;
   };
-  auto bake = [&](Volume& volume, const std::string& source, const LightSpec& light, const std::vector<LightSpec>& sun,
-                  SimulationOptions options, const std::string& out, const std::string& stats_file, double scale,
-                  const std::vector<SpectralBand>& bands, const RunHooks& hooks = {}) {
-    const std::string& output = out;
-    const std::string& stats_path = stats_file;
+  struct VolumeBake {
+    Volume* volume = nullptr;
+    std::string source;
+    double scale = 1.0;
+    SimulationOptions options;
+    std::optional<Volume> scaled;        // the volume at world scale, when scale ≠ 1
+    SimulatorBackendOptions choice;
+    std::unique_ptr<Simulator> simulator;  // one band: one simulator for every run
+    const Volume& atScale() const { return scaled ? *scaled : *volume; }
+  };
+  auto prepare = [&](Volume& volume, const std::string& source, const std::vector<BakeLight>& lights,
+                     SimulationOptions options, double scale, const std::vector<SpectralBand>& bands) {
+    auto bake = std::make_unique<VolumeBake>();
+    bake->volume = &volume;
+    bake->source = source;
+    bake->scale = scale;
     const VolumeDefaults defaults = volumeDefaults(volume.has("interfaces"), volume.grid);
     if (max_depth->count() == 0) options.max_depth = defaults.max_depth;
     if (patch->count() == 0) options.patch_voxels = defaults.patch_voxels;
@@ -241,8 +257,7 @@ int run(int argc, char** argv) {
       std::fprintf(stderr,
                    "lightsim: --volume-deposits auto: nothing in the volume scatters or is opaque and the "
                    "receiver gets a map, so only the map is baked (no irradiance/light_dir fields)\n");
-
-    SimulatorBackendOptions choice;
+    SimulatorBackendOptions& choice = bake->choice;
     choice.backend = backend == "cpu"    ? SimulatorBackend::Cpu
                      : backend == "auto" ? SimulatorBackend::Auto
                                          : SimulatorBackend::Gl;
@@ -256,108 +271,93 @@ int run(int argc, char** argv) {
         std::fprintf(stderr, "lightsim: --backend auto: %s\n", why.c_str());
       };
     // The bake runs in the object's bake frame (scene_bake.h): the volume at world scale.
-    const std::optional<Volume> scaled =
-        scale != 1.0 ? std::optional<Volume>(volumeAtWorldScale(volume, scale)) : std::nullopt;
-    const Volume& at_scale = scaled ? *scaled : volume;
-    // One band: one simulator for every run. Several (spectral_bake.h): the volume at each band's
-    // wavelength, a simulator each, made in turn, the band's share of the light's power, and the
-    // bands' bakes summed.
-    std::unique_ptr<Simulator> simulator = bands.size() == 1 ? makeSimulator(at_scale, choice, &options) : nullptr;
+    if (scale != 1.0) bake->scaled = volumeAtWorldScale(volume, scale);
     if (bands.size() > 1 && !quiet)
       std::fprintf(stderr, "lightsim: dispersive: %zu spectral bands, %.3f to %.3f um, each with its own n(lambda)\n",
                    bands.size(), bands.front().lambda_um, bands.back().lambda_um);
-    if (sun.size() > 1 && !quiet)
-      std::fprintf(stderr, "lightsim: the light's disc of %.3g degrees from %zu directions (soft shadows)\n",
-                   light.angular_diameter_deg, sun.size());
-    // Runs that are summed share one map lattice: the light's own.
-    if (options.receiver && bands.size() * sun.size() > 1) {
+    std::size_t runs = 0;
+    std::vector<LightSpec> point_like;
+    for (const BakeLight& l : lights) {
+      runs += bands.size() * l.directions.size();
+      point_like.push_back(l.light);
+      point_like.back().angular_diameter_deg = 0.0;
+      if (l.directions.size() > 1 && !quiet)
+        std::fprintf(stderr, "lightsim: a light's disc of %.3g degrees from %zu directions (soft shadows)\n",
+                     l.light.angular_diameter_deg, l.directions.size());
+    }
+    // Runs that are summed share one map lattice: the union of the lights' own.
+    if (options.receiver && runs > 1) {
       glm::dvec3 lo, hi;
-      propagationBox(at_scale.grid, options, lo, hi);
-      LightSpec point_like = light;
-      point_like.angular_diameter_deg = 0.0;
-      options.receiver_geometry = receiverGeometry(*options.receiver, point_like, at_scale.grid, lo, hi);
+      propagationBox(bake->atScale().grid, options, lo, hi);
+      options.receiver_geometry = receiverGeometry(*options.receiver, point_like, bake->atScale().grid, lo, hi);
     }
-    ProgressBar bar("lightsim", !quiet && bench_runs == 0);
-    const ProgressFn progress = bar.callback();
-    const std::size_t runs = bands.size() * sun.size();
-    auto runBands = [&] {
-      BandSum sum;
-      for (std::size_t b = 0; b < bands.size(); ++b) {
-        std::unique_ptr<Simulator> band_simulator;
-        if (!simulator || bands.size() > 1) {
-          const Volume band_volume = volumeAtWavelength(at_scale, bands[b].lambda_um);
-          band_simulator = makeSimulator(band_volume, choice, &options);
-          choice.report = nullptr;  // the back end's choice is said once
-        }
-        Simulator& sim = band_simulator ? *band_simulator : *simulator;
-        for (std::size_t d = 0; d < sun.size(); ++d) {
-          const std::size_t r = b * sun.size() + d;
-          LightSpec run_light = sun[d];
-          run_light.power *= bands[b].rgb;
-          SimulationOptions run_options = options;
-          if (progress)
-            run_options.progress = [&, r](double f) { progress((static_cast<double>(r) + f) / static_cast<double>(runs)); };
-          if (hooks.before) hooks.before(r, run_options);
-          BakeResult one = sim.run(run_light, run_options);
-          if (hooks.after) hooks.after(r, one);
-          sum.add(std::move(one));
-        }
-        if (b + 1 == bands.size() && band_simulator) simulator = std::move(band_simulator);  // for lastRunStats
+    if (bands.size() == 1) bake->simulator = makeSimulator(bake->atScale(), choice, &options);
+    bake->options = options;
+    return bake;
+  };
+  // One light's runs, summed; `progress` gets the fraction of them done.
+  auto runLight = [&](VolumeBake& bake, const BakeLight& light, const std::vector<SpectralBand>& bands,
+                      const RunHooks& hooks, const ProgressFn& progress) {
+    const std::vector<LightSpec>& directions = light.directions;
+    const std::size_t runs = bands.size() * directions.size();
+    BandSum sum;
+    for (std::size_t b = 0; b < bands.size(); ++b) {
+      // Several bands (spectral_bake.h): the volume at each band's wavelength, a simulator each,
+      // made in turn, the band's share of the light's power.
+      std::unique_ptr<Simulator> band_simulator;
+      if (bands.size() > 1) {
+        const Volume band_volume = volumeAtWavelength(bake.atScale(), bands[b].lambda_um);
+        band_simulator = makeSimulator(band_volume, bake.choice, &bake.options);
+        bake.choice.report = nullptr;  // the back end's choice is said once
       }
-      return sum.finish();
-    };
-    BakeResult result;
-    std::vector<double> seconds;
-    for (int run = 0; run < std::max(1, bench_runs); ++run) {
-      const Stopwatch watch;
-      result = runBands();
-      seconds.push_back(watch.seconds());
-      if (bench_runs > 0 && !quiet)
-        std::fprintf(stderr, "lightsim: bench run %d of %d: %.3f s\n", run + 1, bench_runs, seconds.back());
+      Simulator& sim = band_simulator ? *band_simulator : *bake.simulator;
+      for (std::size_t d = 0; d < directions.size(); ++d) {
+        const std::size_t r = b * directions.size() + d;
+        LightSpec run_light = directions[d];
+        run_light.power *= bands[b].rgb;
+        SimulationOptions run_options = bake.options;
+        if (progress)
+          run_options.progress = [&, r](double f) { progress((static_cast<double>(r) + f) / static_cast<double>(runs)); };
+        if (hooks.before) hooks.before(r, run_options);
+        BakeResult one = sim.run(run_light, run_options);
+        if (hooks.after) hooks.after(r, one);
+        sum.add(std::move(one));
+      }
+      if (b + 1 == bands.size() && band_simulator) bake.simulator = std::move(band_simulator);  // for lastRunStats
     }
-    bar.finish();
-    nlohmann::json stats_json = result.stats.toJson();
-    stats_json.update(simulator->lastRunStats());
-    if (bench_runs > 0) {
-      std::vector<double> sorted = seconds;
-      std::sort(sorted.begin(), sorted.end());
-      const double median = sorted.size() % 2 ? sorted[sorted.size() / 2]
-                                              : 0.5 * (sorted[sorted.size() / 2 - 1] + sorted[sorted.size() / 2]);
-      const double rate = static_cast<double>(result.stats.total_patches) / median;
-      stats_json["bench"] = {{"runs", bench_runs},
-                             {"seconds", seconds},
-                             {"median_s", median},
-                             {"patch_steps_per_s", rate},
-                             {"grid", {volume.grid.dims.x, volume.grid.dims.y, volume.grid.dims.z}}};
-      std::printf(
-          "lightsim bench: %dx%dx%d, %s: median %.3f s of %d runs (min %.3f, max %.3f); %llu patch-steps, "
-          "%.3g patch-steps/s; peak %llu patches",
-          volume.grid.dims.x, volume.grid.dims.y, volume.grid.dims.z, rendererName(result.stats).c_str(), median,
-          bench_runs, sorted.front(), sorted.back(), static_cast<unsigned long long>(result.stats.total_patches), rate,
-          static_cast<unsigned long long>(result.stats.peak_patches));
-      if (stats_json.contains("texture_bytes"))
-        std::printf("; %.1f MiB of textures at the peak",
-                    static_cast<double>(stats_json["texture_bytes"]["total_peak"].get<std::size_t>()) / (1 << 20));
-      std::printf("\n");
-    }
+    return sum.finish();
+  };
+  // The lights' summed bake into the volume, written to `out` (and the stats to `stats_path`).
+  auto write = [&](VolumeBake& bake, BakeResult result, const std::vector<BakeLight>& lights,
+                   const std::vector<SpectralBand>& bands, const std::string& output, const std::string& stats_path,
+                   nlohmann::json stats_json) {
+    Volume& volume = *bake.volume;
+    stats_json.update(result.stats.toJson());
+    stats_json.update(bake.simulator->lastRunStats());
     if (lightMissedVolume(result.stats))
       std::fprintf(stderr, "lightsim: warning: the light misses the volume; the bake is empty\n");
-
     if (smooth_irradiance > 0.0) smoothIrradiance(result, volume.grid, smooth_irradiance);
-    LightSpec baked_light = light;
-    bakeToVolumeFrame(result, baked_light, scale);
-    applyBake(volume, result, baked_light);
-    volume.metadata["bake_options"] = bakeOptionsToJson(options);
+    // Back in the volume's own coordinates: the maps and every light (the first is the one whose
+    // direct light the maps' readers take off: docs/volume-format.md).
+    std::vector<LightSpec> baked_lights;
+    for (const BakeLight& l : lights) baked_lights.push_back(l.light);
+    bakeToVolumeFrame(result, baked_lights.front(), bake.scale);
+    for (std::size_t k = 1; k < baked_lights.size(); ++k) {
+      BakeResult none;
+      bakeToVolumeFrame(none, baked_lights[k], bake.scale);
+    }
+    applyBake(volume, result, baked_lights);
+    volume.metadata["bake_options"] = bakeOptionsToJson(bake.options);
     if (bands.size() > 1) volume.metadata["bake_bands"] = bands.size();
     if (smooth_irradiance > 0.0) volume.metadata["irradiance_smoothing_sigma_voxels"] = smooth_irradiance;
-    VolumeWriteOptions write;
-    write.gzip = !raw;
+    VolumeWriteOptions write_options;
+    write_options.gzip = !raw;
     // The input's fields are written back as they were read (their encoded samples copied), all but
     // the two a bake makes.
-    write.unchanged_fields = volume.field_files;
-    write.unchanged_fields.erase("irradiance");
-    write.unchanged_fields.erase("light_dir");
-    writeVolume(volume, output, write);
+    write_options.unchanged_fields = volume.field_files;
+    write_options.unchanged_fields.erase("irradiance");
+    write_options.unchanged_fields.erase("light_dir");
+    writeVolume(volume, output, write_options);
     if (!stats_path.empty()) writeFileAtomic(stats_path, stats_json.dump(2) + "\n");
     if (!quiet) {
       const SimulationStats& s = result.stats;
@@ -370,7 +370,11 @@ int run(int argc, char** argv) {
                      luminance(s.flux_in));
       std::fprintf(stderr, "lightsim: wrote %s\n", output.c_str());
     }
-    return kExitOk;
+  };
+  auto bakeLights = [&](const std::vector<LightSpec>& lights) {
+    std::vector<BakeLight> out;
+    for (const LightSpec& l : lights) out.push_back({l, sunDiscSamples(l, sun_samples)});
+    return out;
   };
 
   if (isSceneFile(input)) {
@@ -393,10 +397,7 @@ int run(int argc, char** argv) {
       throw InputError("-o", output, "with a SCENE.json input -o names a folder, and this is a file");
     if (fs::exists(out_dir / "SCENE.json") && fs::equivalent(out_dir / "SCENE.json", fs::path(input)))
       throw InputError("-o", output, "the baked SCENE.json would overwrite the input scene: choose another folder");
-    const LightSpec world_light = lightFromScene(input);
-    if (scene.lights.size() > 1 && !quiet)
-      std::fprintf(stderr, "lightsim: warning: %s has %zu lights; only the first is baked\n", input.c_str(),
-                   scene.lights.size());
+    const std::vector<LightSpec> world_lights = lightsFromScene(input);
     std::optional<ReceiverSpec> ground = receiverFromScene(input);
     if (ground) ground->pitch_voxels = options_receiver_pitch;
     // Every object's volume is read and checked before anything is baked or written.
@@ -439,43 +440,65 @@ int run(int argc, char** argv) {
     // per band), a chain per band.
     const bool dispersive = std::any_of(volumes.begin(), volumes.end(), [](const Volume& v) { return isDispersive(v); });
     const std::vector<SpectralBand> bands = dispersive ? spectralBands(band_count) : spectralBands(1);
-    // A chain per run (band × direction of the light's disc), every one in the same order: the
-    // light's own.
-    const std::vector<LightSpec> world_sun = sunDiscSamples(world_light, sun_samples);
-    std::vector<SceneLightChain> chains;
-    for (std::size_t b = 0; b < bands.size(); ++b)
-      for (const LightSpec& direction : world_sun) chains.emplace_back(boxes, direction, ground, world_light);
-    const SceneLightChain& chain = chains.front();
-    fs::create_directories(out_dir);
-    Scene baked = scene;
-    for (std::size_t step = 0; step < volumes.size(); ++step) {
-      const std::size_t i = chain.order()[step];
+    // Every light in turn, each with the objects in the order it meets them and a chain per run
+    // (band × direction of its disc); each object's bakes under the lights summed, then written.
+    const std::vector<BakeLight> lights = bakeLights(world_lights);
+    std::vector<std::vector<BakeLight>> object_lights(volumes.size());  // in each object's bake frame
+    std::vector<std::unique_ptr<VolumeBake>> bakes;
+    for (std::size_t i = 0; i < volumes.size(); ++i) {
       const BakeFrame frame = BakeFrame::of(scene.objects[i]);
+      for (const BakeLight& l : lights) {
+        BakeLight in_frame{frame.light(l.light), {}};
+        for (const LightSpec& direction : l.directions) in_frame.directions.push_back(frame.light(direction));
+        object_lights[i].push_back(in_frame);
+      }
       SimulationOptions object_options = options;
       if (ground) object_options.receiver = frame.receiver(*ground);
-      if (!quiet) std::fprintf(stderr, "lightsim: [%zu/%zu] %s\n", step + 1, volumes.size(), sources[i].c_str());
-      RunHooks hooks;
-      hooks.before = [&](std::size_t run, SimulationOptions& o) { chains[run].attach(i, o); };
-      hooks.after = [&](std::size_t run, BakeResult& result) {
-        chains[run].correctMap(i, result);
-        if (run + 1 < chains.size() || quiet) return;
-        SceneLightChain::Exchange x;  // over the bands
-        for (const SceneLightChain& c : chains) x += c.exchange(i);
-        if (x.taken_in > 0)
-          std::fprintf(stderr, "lightsim: from the objects before it: %zu patches (%.4g W) taken in\n", x.taken_in,
-                       luminance(x.flux_in));
-        if (x.passed > 0)
-          std::fprintf(stderr, "lightsim: %zu patches (%.4g W) sent on too dim to follow: they pass unchanged\n",
-                       x.passed, luminance(x.flux_passed));
-        if (x.left_out > 0)
-          std::fprintf(stderr, "lightsim: %zu of the light's cells (%.4g W) in their shade\n", x.left_out,
-                       luminance(x.flux_left_out));
-      };
-      std::vector<LightSpec> sun;
-      for (const LightSpec& direction : world_sun) sun.push_back(frame.light(direction));
-      bake(volumes[i], sources[i], frame.light(world_light), sun, object_options, (out_dir / names[i]).string(), "",
-           frame.scale, bands, hooks);
-      volumes[i] = Volume();  // its memory for the next object's bake
+      bakes.push_back(prepare(volumes[i], sources[i], object_lights[i], object_options, frame.scale, bands));
+    }
+    std::vector<BandSum> sums(volumes.size());
+    for (std::size_t l = 0; l < lights.size(); ++l) {
+      std::vector<SceneLightChain> chains;
+      for (std::size_t b = 0; b < bands.size(); ++b)
+        for (const LightSpec& direction : lights[l].directions)
+          chains.emplace_back(boxes, direction, ground, lights[l].light);
+      const SceneLightChain& chain = chains.front();
+      for (std::size_t step = 0; step < volumes.size(); ++step) {
+        const std::size_t i = chain.order()[step];
+        if (!quiet) {
+          const std::string which =
+              lights.size() > 1 ? "light " + std::to_string(l + 1) + "/" + std::to_string(lights.size()) + ", " : "";
+          std::fprintf(stderr, "lightsim: [%sobject %zu/%zu] %s\n", which.c_str(), step + 1, volumes.size(),
+                       sources[i].c_str());
+        }
+        RunHooks hooks;
+        hooks.before = [&](std::size_t run, SimulationOptions& o) { chains[run].attach(i, o); };
+        hooks.after = [&](std::size_t run, BakeResult& result) {
+          chains[run].correctMap(i, result);
+          if (run + 1 < chains.size() || quiet) return;
+          SceneLightChain::Exchange x;  // over the bands
+          for (const SceneLightChain& c : chains) x += c.exchange(i);
+          if (x.taken_in > 0)
+            std::fprintf(stderr, "lightsim: from the objects before it: %zu patches (%.4g W) taken in\n", x.taken_in,
+                         luminance(x.flux_in));
+          if (x.passed > 0)
+            std::fprintf(stderr, "lightsim: %zu patches (%.4g W) sent on too dim to follow: they pass unchanged\n",
+                         x.passed, luminance(x.flux_passed));
+          if (x.left_out > 0)
+            std::fprintf(stderr, "lightsim: %zu of the light's cells (%.4g W) in their shade\n", x.left_out,
+                         luminance(x.flux_left_out));
+        };
+        ProgressBar bar("lightsim", !quiet);
+        sums[i].add(runLight(*bakes[i], object_lights[i][l], bands, hooks, bar.callback()));
+        bar.finish();
+      }
+    }
+    fs::create_directories(out_dir);
+    Scene baked = scene;
+    for (std::size_t i = 0; i < volumes.size(); ++i) {
+      write(*bakes[i], sums[i].finish(), object_lights[i], bands, (out_dir / names[i]).string(), "", nlohmann::json());
+      bakes[i].reset();
+      volumes[i] = Volume();
       baked.objects[i].volume = names[i];
     }
     if (!scene.environment.file.empty()) {
@@ -497,7 +520,9 @@ int run(int argc, char** argv) {
   }
   if (light_text.empty() == scene_path.empty())
     throw InputError("command line", "--light", "give either --light (with --power) or --scene");
-  const LightSpec light = scene_path.empty() ? parseLight(light_text, power_text) : lightFromScene(scene_path);
+  // --light, or every light of the --scene (summed).
+  const std::vector<LightSpec> lights_to_bake =
+      scene_path.empty() ? std::vector<LightSpec>{parseLight(light_text, power_text)} : lightsFromScene(scene_path);
   if (!receiver_text.empty() && no_receiver)
     throw InputError("command line", "--no-receiver", "give --receiver or --no-receiver, not both");
   if (!receiver_text.empty()) {
@@ -510,8 +535,54 @@ int run(int argc, char** argv) {
   volume.require("ior", 1, input);
   volume.require("ior_grad", 3, input);
   interfaceTable(volume, input);  // a malformed table is named with the file, before any work
-  return bake(volume, input, light, sunDiscSamples(light, sun_samples), options, output, stats_path, 1.0,
-              isDispersive(volume) ? spectralBands(band_count) : spectralBands(1));
+  const std::vector<SpectralBand> bands = isDispersive(volume) ? spectralBands(band_count) : spectralBands(1);
+  const std::vector<BakeLight> lights = bakeLights(lights_to_bake);
+  std::unique_ptr<VolumeBake> bake = prepare(volume, input, lights, options, 1.0, bands);
+  BakeResult result;
+  std::vector<double> seconds;
+  for (int run = 0; run < std::max(1, bench_runs); ++run) {
+    ProgressBar bar("lightsim", !quiet && bench_runs == 0);
+    const ProgressFn progress = bar.callback();
+    const Stopwatch watch;
+    BandSum sum;
+    for (std::size_t l = 0; l < lights.size(); ++l) {
+      ProgressFn light_progress;
+      if (progress)
+        light_progress = [&, l](double f) { progress((static_cast<double>(l) + f) / static_cast<double>(lights.size())); };
+      sum.add(runLight(*bake, lights[l], bands, {}, light_progress));
+    }
+    result = sum.finish();
+    seconds.push_back(watch.seconds());
+    bar.finish();
+    if (bench_runs > 0 && !quiet)
+      std::fprintf(stderr, "lightsim: bench run %d of %d: %.3f s\n", run + 1, bench_runs, seconds.back());
+  }
+  nlohmann::json stats_json = nlohmann::json::object();
+  if (bench_runs > 0) {
+    std::vector<double> sorted = seconds;
+    std::sort(sorted.begin(), sorted.end());
+    const double median = sorted.size() % 2 ? sorted[sorted.size() / 2]
+                                            : 0.5 * (sorted[sorted.size() / 2 - 1] + sorted[sorted.size() / 2]);
+    const double rate = static_cast<double>(result.stats.total_patches) / median;
+    stats_json["bench"] = {{"runs", bench_runs},
+                           {"seconds", seconds},
+                           {"median_s", median},
+                           {"patch_steps_per_s", rate},
+                           {"grid", {volume.grid.dims.x, volume.grid.dims.y, volume.grid.dims.z}}};
+    const nlohmann::json backend_stats = bake->simulator->lastRunStats();
+    std::printf(
+        "lightsim bench: %dx%dx%d, %s: median %.3f s of %d runs (min %.3f, max %.3f); %llu patch-steps, "
+        "%.3g patch-steps/s; peak %llu patches",
+        volume.grid.dims.x, volume.grid.dims.y, volume.grid.dims.z, rendererName(result.stats).c_str(), median,
+        bench_runs, sorted.front(), sorted.back(), static_cast<unsigned long long>(result.stats.total_patches), rate,
+        static_cast<unsigned long long>(result.stats.peak_patches));
+    if (backend_stats.contains("texture_bytes"))
+      std::printf("; %.1f MiB of textures at the peak",
+                  static_cast<double>(backend_stats["texture_bytes"]["total_peak"].get<std::size_t>()) / (1 << 20));
+    std::printf("\n");
+  }
+  write(*bake, std::move(result), lights, bands, output, stats_path, stats_json);
+  return kExitOk;
 }
 
 }  // namespace

@@ -12,33 +12,43 @@ namespace eik {
 
 ReceiverMap receiverGeometry(const ReceiverSpec& spec, const LightSpec& light, const GridSpec& grid,
                              const glm::dvec3& box_lo, const glm::dvec3& box_hi) {
+  return receiverGeometry(spec, std::vector<LightSpec>{light}, grid, box_lo, box_hi);
+}
+
+ReceiverMap receiverGeometry(const ReceiverSpec& spec, const std::vector<LightSpec>& lights, const GridSpec& grid,
+                             const glm::dvec3& box_lo, const glm::dvec3& box_hi) {
   ReceiverMap map;
   map.name = spec.name;
   map.point = spec.point;
   map.normal = glm::normalize(spec.normal);
   receiverAxes(map.normal, map.u, map.v);
-  // The box's corners seen from the light, on the plane.
   glm::dvec2 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
-  for (int k = 0; k < 8; ++k) {
-    const glm::dvec3 corner((k & 1) ? box_hi.x : box_lo.x, (k & 2) ? box_hi.y : box_lo.y, (k & 4) ? box_hi.z : box_lo.z);
-    glm::dvec3 dir = light.type == LightSpec::Type::Directional ? glm::normalize(light.direction)
-                                                                : corner - light.position;
-    const double facing = glm::dot(dir, map.normal);
-    if (!(facing < 0.0))
-      throw InputError("receiver", spec.name,
-                       "the light does not reach the plane from its front side (the plane's normal must face the light)");
-    const double height = glm::dot(corner - map.point, map.normal);
-    // Corners below the plane project back up along the light; either way onto the plane.
-    const glm::dvec3 on_plane = corner - (height / facing) * dir;
-    const glm::dvec2 uv = map.planeCoordinates(on_plane);
-    lo = glm::min(lo, uv);
-    hi = glm::max(hi, uv);
+  for (const LightSpec& light : lights) {
+    // The box's corners seen from the light, on the plane.
+    glm::dvec2 shadow_lo(std::numeric_limits<double>::infinity()), shadow_hi(-std::numeric_limits<double>::infinity());
+    for (int k = 0; k < 8; ++k) {
+      const glm::dvec3 corner((k & 1) ? box_hi.x : box_lo.x, (k & 2) ? box_hi.y : box_lo.y, (k & 4) ? box_hi.z : box_lo.z);
+      glm::dvec3 dir = light.type == LightSpec::Type::Directional ? glm::normalize(light.direction)
+                                                                  : corner - light.position;
+      const double facing = glm::dot(dir, map.normal);
+      if (!(facing < 0.0))
+        throw InputError("receiver", spec.name,
+                         "the light does not reach the plane from its front side (the plane's normal must face the light)");
+      const double height = glm::dot(corner - map.point, map.normal);
+      // Corners below the plane project back up along the light; either way onto the plane.
+      const glm::dvec3 on_plane = corner - (height / facing) * dir;
+      const glm::dvec2 uv = map.planeCoordinates(on_plane);
+      shadow_lo = glm::min(shadow_lo, uv);
+      shadow_hi = glm::max(shadow_hi, uv);
+    }
+    // Light the object reflects or bends lands beyond its shadow: the map reaches one shadow-size
+    // further on every side, within the plane's square; several lights, the union of theirs.
+    const glm::dvec2 grow(std::max(shadow_hi.x - shadow_lo.x, shadow_hi.y - shadow_lo.y));
+    lo = glm::min(lo, shadow_lo - grow);
+    hi = glm::max(hi, shadow_hi + grow);
   }
-  // Light the object reflects or bends lands beyond its shadow: the map reaches one shadow-size
-  // further on every side, within the plane's square.
-  const glm::dvec2 grow(std::max(hi.x - lo.x, hi.y - lo.y));
-  lo = glm::max(lo - grow, glm::dvec2(-spec.half_extent));
-  hi = glm::min(hi + grow, glm::dvec2(spec.half_extent));
+  lo = glm::max(lo, glm::dvec2(-spec.half_extent));
+  hi = glm::min(hi, glm::dvec2(spec.half_extent));
   if (!(lo.x < hi.x && lo.y < hi.y))
     throw InputError("receiver", spec.name, "the volume's box does not shade any part of the plane's square");
   map.pitch = spec.pitch_voxels * voxelEdge(grid);

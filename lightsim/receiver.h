@@ -34,6 +34,10 @@ struct Patch;
 // does not reach the plane from its front (normal) side.
 ReceiverMap receiverGeometry(const ReceiverSpec& spec, const LightSpec& light, const GridSpec& grid,
                              const glm::dvec3& box_lo, const glm::dvec3& box_hi);
+// One lattice for several lights' runs that are summed (a scene's lights): the union of each
+// light's region above, at the same pitch (coarser only to stay within kMaxReceiverTexels).
+ReceiverMap receiverGeometry(const ReceiverSpec& spec, const std::vector<LightSpec>& lights, const GridSpec& grid,
+                             const glm::dvec3& box_lo, const glm::dvec3& box_hi);
 constexpr int kMaxReceiverTexels = 1024;
 
 // Where the rays of a patch's corners (x_c along w_c) meet the plane, in the plane's (u, v)

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <csignal>
+#include <cstdio>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -344,6 +345,73 @@ TEST(LightsimCli, AnObjectBehindAnotherFromTheLightGetsLessLight) {
   std::printf("the sphere's irradiance under the slab / beside it: %.4f\n", sums[0] / sums[1]);
   EXPECT_GT(sums[0] / sums[1], 0.25);
   EXPECT_LT(sums[0] / sums[1], 0.40);
+}
+
+// Every light of a scene, summed: a dark glass slab (σa = 6 per unit, 0.2 thick) over the ground
+// under a sun straight down (E = 1) and one 45° off it (E = 0.5), one bake with both lights against
+// a bake of each alone. The two-light map, looked up where each one-light map is, is their sum (the
+// runs share one lattice; a run's light is what it would be alone): under the slab in the first
+// sun's shadow and the second's light, in the second sun's shadow and the first's light, and out in
+// the open (1 + 0.5·cos 45° = 1.354). The manifest names both lights, the first as "light" (the one
+// whose direct light the viewer takes off exactly; the others it takes off the map, ground_map.h),
+// and the viewer draws the ground from them.
+TEST(LightsimCli, EveryLightOfTheSceneIsBakedAndSummed) {
+  TempDir dir;
+  ProgramResult slab = runProgram(VOXELIZE_EXE,
+                                  {"procedural:box,size=1.6:0.2:1.6,ior=1.5,sigma_a=6:6:6", "-o", "slab.vol.json",
+                                   "--res", "24", "--interfaces", "sharp", "--quiet"},
+                                  dir.path());
+  ASSERT_EQ(slab.exit_code, 0) << slab.output;
+  const std::string overhead = R"({"type": "directional", "direction": [0, -1, 0], "irradiance": [1, 1, 1]})";
+  const std::string tilted = R"({"type": "directional", "direction": [1, -1, 0], "irradiance": [0.5, 0.5, 0.5]})";
+  const std::vector<std::pair<std::string, std::string>> scenes = {
+      {"both", overhead + ", " + tilted}, {"first", overhead}, {"second", tilted}};
+  for (const auto& [name, lights] : scenes) {
+    writeFile(dir / (name + ".json"), R"({
+      "camera": {"eye": [0, 1.5, 4], "target": [0, -0.8, 0]},
+      "lights": [)" + lights + R"(],
+      "ground": {"point": [0, -1.2, 0], "normal": [0, 1, 0], "half_extent": 4},
+      "objects": [{"volume": "slab.vol.json"}]})");
+    ProgramResult r = runProgram(LIGHTSIM_EXE, {name + ".json", "-o", name}, dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(r.output.find("light 2/2") != std::string::npos, name == "both") << r.output;
+  }
+  const Volume both = readVolume(dir / "both" / "slab.baked.vol.json");
+  const Volume first = readVolume(dir / "first" / "slab.baked.vol.json");
+  const Volume second = readVolume(dir / "second" / "slab.baked.vol.json");
+  ASSERT_TRUE(both.metadata.contains("lights"));
+  ASSERT_EQ(both.metadata["lights"].size(), 2u);
+  EXPECT_EQ(both.metadata["lights"][0], both.metadata["light"]);
+  EXPECT_EQ(both.metadata["lights"][1]["irradiance"][0], 0.5);
+  EXPECT_FALSE(first.metadata.contains("lights"));
+  // Irradiance (green) at a ground point of each map, from its texel (the maps' lattices differ).
+  auto at = [](const Volume& v, double x) {
+    const ReceiverMap& map = v.receivers.at(0);
+    const glm::dvec2 uv = (map.planeCoordinates(glm::dvec3(x, -1.2, 0.0)) - map.origin) / map.pitch;
+    const int i = static_cast<int>(uv.x), j = static_cast<int>(uv.y);
+    EXPECT_TRUE(i >= 0 && j >= 0 && i < map.texels.x && j < map.texels.y) << x;
+    return map.irradiance.at(3 * (static_cast<std::size_t>(j) * map.texels.x + i) + 1);
+  };
+  // x = −0.4: under the slab for the first sun, in the open for the second (its shadow, through the
+  // slab, lies over 0.4–1.8); x = 1.3: the other way round; x = 2.4: open to both. Each a few
+  // voxels (0.067) from any shadow's edge.
+  for (const double x : {-0.4, 1.3, 2.4}) {
+    const double sum = at(first, x) + at(second, x);
+    std::printf("x = %.1f: both %.4f, first + second %.4f (%.4f + %.4f)\n", x, at(both, x), sum, at(first, x), at(second, x));
+    // Tolerance: the texel that holds x on the shared lattice is not the one-light maps' texel (a
+    // quarter voxel apart at most), and away from shadow edges the light changes by far less than 2 %
+    // over it; a dropped or doubled light would be 35 % off at least.
+    EXPECT_NEAR(at(both, x) / sum, 1.0, 0.02) << x;
+  }
+  EXPECT_NEAR(at(both, 2.4), 1.0 + 0.5 * std::sqrt(0.5), 0.01);
+  // Through the slab: e^−1.2 ≈ 0.30 of the first sun (0.28 with the faces' reflections), and of
+  // the second's 0.354 e^−6·0.227 (refracted to 28°) ≈ 0.26, 0.081 with the reflections.
+  EXPECT_NEAR(at(first, -0.4), 0.28, 0.05);
+  EXPECT_NEAR(at(second, 1.3), 0.081, 0.02);
+  // The summed ledger closes.
+  EXPECT_LT(both.metadata["bake_stats"]["flux"]["ledger_relative_residual"].get<double>(), 1e-6);
+  ProgramResult v = runProgram(VIEWER_EXE, {"both/SCENE.json", "--render", "both.png", "--size", "96x64"}, dir.path());
+  EXPECT_EQ(v.exit_code, 0) << v.output;
 }
 
 // `--bands N`: a dispersive volume (here a flint sphere, Abbe 20) is baked band by band, the bands'

@@ -10,19 +10,28 @@
 
 namespace eik {
 
-glm::dvec3 bakedDirectIrradiance(const ReceiverLayer& layer, const glm::dvec3& x, const glm::dvec3& normal) {
-  const glm::dvec3 pos(layer.light_pos);
-  if (layer.light_pos.w == 0.0) return layer.light_power * std::max(0.0, -glm::dot(normal, pos));
+glm::dvec3 directIrradiance(const ReceiverLayer::Light& light, const glm::dvec3& x, const glm::dvec3& normal) {
+  const glm::dvec3 pos(light.pos);
+  if (light.pos.w == 0.0) return light.power * std::max(0.0, -glm::dot(normal, pos));
   const glm::dvec3 L = pos - x;
   const double r2 = std::max(glm::dot(L, L), 1e-12);
   double spot = 1.0;
-  if (layer.light_spot_scale > 0.0) {
-    const double t = std::clamp((glm::dot(glm::dvec3(layer.light_spot), -L / std::sqrt(r2)) - layer.light_spot.w) *
-                                    layer.light_spot_scale,
-                                0.0, 1.0);
+  if (light.spot_scale > 0.0) {
+    const double t =
+        std::clamp((glm::dot(glm::dvec3(light.spot), -L / std::sqrt(r2)) - light.spot.w) * light.spot_scale, 0.0, 1.0);
     spot = t * t;
   }
-  return layer.light_power * (spot * std::max(0.0, glm::dot(normal, L) / std::sqrt(r2)) / r2);
+  return light.power * (spot * std::max(0.0, glm::dot(normal, L) / std::sqrt(r2)) / r2);
+}
+
+glm::dvec3 bakedDirectIrradiance(const ReceiverLayer& layer, const glm::dvec3& x, const glm::dvec3& normal) {
+  return directIrradiance({layer.light_pos, layer.light_power, layer.light_spot, layer.light_spot_scale}, x, normal);
+}
+
+glm::dvec3 otherLightsIrradiance(const ReceiverLayer& layer, const glm::dvec3& x, const glm::dvec3& normal) {
+  glm::dvec3 sum(0.0);
+  for (const ReceiverLayer::Light& light : layer.other_lights) sum += directIrradiance(light, x, normal);
+  return sum;
 }
 
 bool receiverChangeAt(const ReceiverLayer& layer, const glm::dvec3& xw, glm::dvec3& change) {
@@ -47,7 +56,9 @@ bool receiverChangeAt(const ReceiverLayer& layer, const glm::dvec3& xw, glm::dve
   };
   const glm::dvec4 E = (1 - fx) * (1 - fy) * texel(i0, j0) + fx * (1 - fy) * texel(i0 + 1, j0) +
                        (1 - fx) * fy * texel(i0, j0 + 1) + fx * fy * texel(i0 + 1, j0 + 1);
-  change = glm::dvec3(E) - bakedDirectIrradiance(layer, x, glm::cross(map.u, map.v)) * (E.w >= 0.0 ? 1.0 : 2.0);
+  const glm::dvec3 normal = glm::cross(map.u, map.v);
+  change = glm::dvec3(E) - bakedDirectIrradiance(layer, x, normal) * (E.w >= 0.0 ? 1.0 : 2.0);
+  if (!layer.texels) change -= otherLightsIrradiance(layer, x, normal);
   return true;
 }
 

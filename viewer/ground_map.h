@@ -31,9 +31,19 @@ struct ReceiverLayer {
   glm::dvec4 light_spot{0.0};
   double light_spot_scale = 0.0;
   // The receiver texture the viewer made of the map (shadow_edge.h receiverTexels: rgb the map with
-  // the direct light its geometric shadow takes added back, a the shadow clearance), or null: the
-  // map itself.
+  // the direct light its geometric shadow takes added back and the other lights' direct light taken
+  // off, a the shadow clearance), or null: the map itself.
   const std::vector<float>* texels = nullptr;
+  // The other lights the map was baked with (a scene's lights summed: the manifest's "lights" after
+  // the first), in volume space, as light_pos … light_spot_scale are: their direct light is taken
+  // off the map too.
+  struct Light {
+    glm::dvec4 pos{0.0, -1.0, 0.0, 0.0};
+    glm::dvec3 power{0.0};
+    glm::dvec4 spot{0.0};
+    double spot_scale = 0.0;
+  };
+  std::vector<Light> other_lights;
 };
 
 struct GroundMap {
@@ -49,11 +59,16 @@ struct GroundMap {
 // Planar irradiance at x (volume space) on a surface of normal N from the light of `layer`,
 // unoccluded: E·cos θ, or I·cos θ/r² (raymarch.frag lightIrradiance).
 glm::dvec3 bakedDirectIrradiance(const ReceiverLayer& layer, const glm::dvec3& x, const glm::dvec3& normal);
+// The same from one of its other lights.
+glm::dvec3 directIrradiance(const ReceiverLayer::Light& light, const glm::dvec3& x, const glm::dvec3& normal);
+// The other lights' together.
+glm::dvec3 otherLightsIrradiance(const ReceiverLayer& layer, const glm::dvec3& x, const glm::dvec3& normal);
 
 // The change `layer` makes at world point xw of its plane (object.glsl receiverChange): its map
 // filtered bilinearly (texel centres, clamped at the edges, as the texture is) less the direct
-// light; with `texels`, that texture filtered so, less the direct light twice where the filtered
-// clearance is negative (shadow_edge.h). False where the map does not reach.
+// light (of every light it was baked with); with `texels`, that texture filtered so (the other
+// lights already off), less the direct light twice where the filtered clearance is negative
+// (shadow_edge.h). False where the map does not reach.
 bool receiverChangeAt(const ReceiverLayer& layer, const glm::dvec3& xw, glm::dvec3& change);
 
 // The ground map of `layers` on the plane through `point` with unit in-plane axes u, v: it covers

@@ -3,6 +3,7 @@
 // map's lattice kept, and fields that bilinear filtering reproduces exactly (linear ones) coming
 // back exactly at any point.
 #include "viewer/ground_map.h"
+#include "viewer/shadow_edge.h"
 
 #include <gtest/gtest.h>
 
@@ -72,6 +73,41 @@ TEST(ReceiverChange, IsTheMapFilteredBilinearlyLessTheDirectLightAndNothingBeyon
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(change[c], expected[c], 1e-6) << c;
   EXPECT_FALSE(receiverChangeAt(layer, {1.31 + 0.3, 0.0, 0.0}, change));  // past the map's edge
   EXPECT_EQ(change, glm::dvec3(0.0));
+}
+
+// A map baked with a scene's lights summed (the manifest's "lights"): the change is the map less
+// every light's direct light, read from the map itself or from the receiver texture the viewer
+// makes of it (receiverTexels: the other lights taken off each texel, the first left to the
+// shader). Here a sun straight down (2) and a point light 1.5 over the map's (0.4, 0, 0) (I = 3):
+// its direct light 3·cos θ/r² varies across the map, so a texture that took it off at the wrong
+// place, or not at all, would be off by up to 1.33.
+TEST(ReceiverChange, TakesOffEveryLightTheMapWasBakedWith) {
+  const ReceiverMap map = linearMap({-1.0, -1.0}, 0.05, {40, 40}, {4.0, 4.0, 4.0}, {0.5, 0.0, -0.5}, {0.0, 0.25, 0.0});
+  ReceiverLayer layer = layerAt(map, glm::dmat4(1.0));
+  ReceiverLayer::Light lamp;
+  lamp.pos = glm::dvec4(0.4, 1.5, 0.0, 1.0);
+  lamp.power = glm::dvec3(3.0);
+  layer.other_lights = {lamp};
+  const std::vector<float> texels = receiverTexels(layer, {});
+  ReceiverLayer textured = layer;
+  textured.texels = &texels;
+  for (const glm::dvec3 x : {glm::dvec3(0.4, 0.0, 0.0), glm::dvec3(-0.6, 0.0, 0.3), glm::dvec3(0.8, 0.0, -0.7)}) {
+    const glm::dvec3 to_lamp = glm::dvec3(lamp.pos) - x;
+    const double r2 = glm::dot(to_lamp, to_lamp);
+    const double lamp_light = 3.0 * (to_lamp.y / std::sqrt(r2)) / r2;
+    glm::dvec3 plain, from_texture;
+    ASSERT_TRUE(receiverChangeAt(layer, x, plain));
+    ASSERT_TRUE(receiverChangeAt(textured, x, from_texture));
+    const glm::dvec3 expected = glm::dvec3(4.0) + glm::dvec3(0.5, 0.0, -0.5) * x.x + glm::dvec3(0.0, 0.25, 0.0) * -x.z -
+                                glm::dvec3(2.0) - glm::dvec3(lamp_light);
+    // The map is linear, so bilinear filtering reproduces it; the lamp's light is curved, and the
+    // texture holds it at texel centres: within the bilinear error of I·cos θ/r² over 0.05 (its
+    // second derivative is under 10 here: 10·0.05²/8 ≈ 3·10⁻³).
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(plain[c], expected[c], 1e-5) << c;
+      EXPECT_NEAR(from_texture[c], expected[c], 5e-3) << c;
+    }
+  }
 }
 
 TEST(GroundMap, SumsTheChangesOfTwoMapsAtAnyPointAndCoversTheirUnion) {

@@ -20,39 +20,45 @@ void requireOptics(const Volume& volume, const std::string& source) {
   volume.require("ior_grad", 3, source);
 }
 
-// The light a bare volume was baked with (lightsim's "light" manifest entry), if it is one.
+// The lights a bare volume was baked with (lightsim's "lights" manifest entry when it summed
+// several, else its "light"), those that parse.
 std::vector<SceneLightSpec> bakedLights(const Volume& volume) {
   std::vector<SceneLightSpec> lights;
-  const auto it = volume.metadata.find("light");
-  if (it == volume.metadata.end() || !it->is_object()) return lights;
-  try {
-    const nlohmann::json& j = *it;
-    const std::string type = j.value("type", std::string());
-    auto vec = [&](const char* key, glm::dvec3 fallback) {
-      if (!j.contains(key) || !j.at(key).is_array() || j.at(key).size() != 3) return fallback;
-      return glm::dvec3(j.at(key)[0].get<double>(), j.at(key)[1].get<double>(), j.at(key)[2].get<double>());
-    };
-    SceneLightSpec light;
-    if (type == "directional") {
-      light.type = SceneLightSpec::Type::Directional;
-      light.direction = vec("direction", light.direction);
-      if (glm::length(light.direction) > 0) light.direction = glm::normalize(light.direction);
-      light.irradiance = vec("irradiance", light.irradiance);
-      lights.push_back(light);
-    } else if (type == "point" || type == "spot") {
-      light.type = type == "spot" ? SceneLightSpec::Type::Spot : SceneLightSpec::Type::Point;
-      light.position = vec("position", light.position);
-      light.intensity = vec("intensity", light.intensity);
-      if (type == "spot") {
+  std::vector<nlohmann::json> entries;
+  if (const auto all = volume.metadata.find("lights"); all != volume.metadata.end() && all->is_array())
+    entries.assign(all->begin(), all->end());
+  else if (const auto one = volume.metadata.find("light"); one != volume.metadata.end())
+    entries.push_back(*one);
+  for (const nlohmann::json& j : entries) {
+    if (!j.is_object()) continue;
+    try {
+      const std::string type = j.value("type", std::string());
+      auto vec = [&](const char* key, glm::dvec3 fallback) {
+        if (!j.contains(key) || !j.at(key).is_array() || j.at(key).size() != 3) return fallback;
+        return glm::dvec3(j.at(key)[0].get<double>(), j.at(key)[1].get<double>(), j.at(key)[2].get<double>());
+      };
+      SceneLightSpec light;
+      if (type == "directional") {
+        light.type = SceneLightSpec::Type::Directional;
         light.direction = vec("direction", light.direction);
         if (glm::length(light.direction) > 0) light.direction = glm::normalize(light.direction);
-        light.inner_cone_deg = j.value("inner_cone_deg", light.inner_cone_deg);
-        light.outer_cone_deg = j.value("outer_cone_deg", light.outer_cone_deg);
+        light.irradiance = vec("irradiance", light.irradiance);
+        lights.push_back(light);
+      } else if (type == "point" || type == "spot") {
+        light.type = type == "spot" ? SceneLightSpec::Type::Spot : SceneLightSpec::Type::Point;
+        light.position = vec("position", light.position);
+        light.intensity = vec("intensity", light.intensity);
+        if (type == "spot") {
+          light.direction = vec("direction", light.direction);
+          if (glm::length(light.direction) > 0) light.direction = glm::normalize(light.direction);
+          light.inner_cone_deg = j.value("inner_cone_deg", light.inner_cone_deg);
+          light.outer_cone_deg = j.value("outer_cone_deg", light.outer_cone_deg);
+        }
+        lights.push_back(light);
       }
-      lights.push_back(light);
+    } catch (const nlohmann::json::exception&) {
+      // metadata is informative here; a malformed entry only loses that light on the ground
     }
-  } catch (const nlohmann::json::exception&) {
-    lights.clear();  // metadata is informative here; a malformed entry only loses the ground light
   }
   return lights;
 }

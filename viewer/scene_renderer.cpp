@@ -44,6 +44,7 @@ struct SceneRenderer::Impl {
     glm::vec3 receiver_light_power{0.0f};
     glm::vec4 receiver_light_spot{0.0f};
     float receiver_light_spot_scale = 0.0f;
+    std::vector<ReceiverLayer::Light> receiver_other_lights;  // the map's other lights (ReceiverLayer)
   };
 
   const gl::ShaderLibrary& shaders;
@@ -81,6 +82,7 @@ struct SceneRenderer::Impl {
     glm::vec4 light_spot{0.0f};  // a spot light's axis and cos θ_outer (ReceiverLayer)
     float light_spot_scale = 0.0f;
     bool light_disc = false;  // a directional light with an angular size: the map's soft shadow as baked
+    std::vector<ReceiverLayer::Light> other_lights;  // the other lights summed into the map ("lights")
   };
   static GroundReceiver findGroundReceiver(const LoadedObject& loaded, const SceneGroundSpec& ground) {
     const glm::dmat4 to_volume = glm::inverse(loaded.object_to_world);
@@ -91,33 +93,54 @@ struct SceneRenderer::Impl {
       if (glm::dot(normal, map.normal) < 0.9999 || std::abs(glm::dot(point - map.point, map.normal)) > scale) continue;
       const nlohmann::json& light = loaded.volume.metadata.value("light", nlohmann::json());
       if (!light.is_object() || !light.contains("type")) continue;
-      auto vec3Of = [&](const char* key) {
-        const nlohmann::json& a = light.at(key);
-        return glm::vec3(a.at(0).get<float>(), a.at(1).get<float>(), a.at(2).get<float>());
-      };
       GroundReceiver found;
       found.map = &map;
-      try {
-        if (light.at("type") == "directional") {
-          found.light_disc = light.value("angular_diameter_deg", 0.0) > 0.0;
-          found.light_pos = glm::vec4(glm::normalize(vec3Of("direction")), 0.0f);
-          found.light_power = vec3Of("irradiance");
-        } else {
-          found.light_pos = glm::vec4(vec3Of("position"), 1.0f);
-          found.light_power = vec3Of("intensity");
-          if (light.at("type") == "spot") {
-            const SpotCone cone = spotCone(glm::dvec3(vec3Of("direction")), light.at("inner_cone_deg").get<double>(),
-                                           light.at("outer_cone_deg").get<double>());
-            found.light_spot = cone.axis_cos_outer;
-            found.light_spot_scale = cone.scale;
-          }
-        }
-      } catch (const nlohmann::json::exception&) {
-        throw InputError(loaded.source, "light", "the baked light is malformed");
+      found.light_disc = light.value("angular_diameter_deg", 0.0) > 0.0 && light.value("type", "") == "directional";
+      const ReceiverLayer::Light first = bakedLight(loaded, light, "light");
+      found.light_pos = glm::vec4(first.pos);
+      found.light_power = glm::vec3(first.power);
+      found.light_spot = glm::vec4(first.spot);
+      found.light_spot_scale = static_cast<float>(first.spot_scale);
+      // A scene's lights summed (lightsim SCENE.json): the map holds them all; the first is "light".
+      const nlohmann::json& lights = loaded.volume.metadata.value("lights", nlohmann::json());
+      if (!lights.is_null()) {
+        if (!lights.is_array() || lights.empty() || lights.front() != light)
+          throw InputError(loaded.source, "lights", "must be a list of the baked lights beginning with \"light\"");
+        for (std::size_t k = 1; k < lights.size(); ++k)
+          found.other_lights.push_back(bakedLight(loaded, lights[k], "lights[" + std::to_string(k) + "]"));
       }
       return found;
     }
     return {};
+  }
+
+  // A baked light of the manifest (lightsim's LightSpec::toJson), as the ground's shading takes it.
+  static ReceiverLayer::Light bakedLight(const LoadedObject& loaded, const nlohmann::json& light, const std::string& key) {
+    ReceiverLayer::Light out;
+    try {
+      auto vec3Of = [&](const char* name) {
+        const nlohmann::json& a = light.at(name);
+        return glm::dvec3(a.at(0).get<double>(), a.at(1).get<double>(), a.at(2).get<double>());
+      };
+      if (light.at("type") == "directional") {
+        out.pos = glm::dvec4(glm::normalize(vec3Of("direction")), 0.0);
+        out.power = vec3Of("irradiance");
+      } else {
+        out.pos = glm::dvec4(vec3Of("position"), 1.0);
+        out.power = vec3Of("intensity");
+        if (light.at("type") == "spot") {
+          const SpotCone cone =
+              spotCone(vec3Of("direction"), light.at("inner_cone_deg").get<double>(), light.at("outer_cone_deg").get<double>());
+          out.spot = cone.axis_cos_outer;
+          out.spot_scale = cone.scale;
+        }
+      }
+    } catch (const nlohmann::json::exception&) {
+      throw InputError(loaded.source, key, "the baked light is malformed");
+    }
+    if (!std::isfinite(glm::dot(out.pos, out.pos)) || !std::isfinite(glm::dot(out.power, out.power)))
+      throw InputError(loaded.source, key, "the baked light is malformed");
+    return out;
   }
 
   // The receiver texture's texels: the map with its shadow's edge to the pixel (shadow_edge.h:
@@ -131,7 +154,9 @@ struct SceneRenderer::Impl {
                         glm::dvec4(found.light_pos),
                         glm::dvec3(found.light_power),
                         glm::dvec4(found.light_spot),
-                        found.light_spot_scale};
+                        found.light_spot_scale,
+                        nullptr,
+                        found.other_lights};
     const std::vector<float> clearance =
         found.light_pos.w == 0.0f && !found.light_disc ? shadowClearance(loaded.volume, *found.map, glm::dvec3(found.light_pos))
                                   : std::vector<float>();
@@ -146,6 +171,7 @@ struct SceneRenderer::Impl {
     o.receiver_light_power = found.light_power;
     o.receiver_light_spot = found.light_spot;
     o.receiver_light_spot_scale = found.light_spot_scale;
+    o.receiver_other_lights = found.other_lights;
     o.receiver = *found.map;  // with its irradiance, for the ground map
     o.receiver_texture = gl::Texture2D(found.map->texels, gl::TextureFormat::RGBA32F,
                                        prepared ? *prepared : groundTexels(loaded, found), 4);
@@ -208,10 +234,11 @@ struct SceneRenderer::Impl {
     if (!scene.ground) return;
     std::vector<ReceiverLayer> layers;
     for (const Object& o : objects)
-      if (o.has_receiver)
+      if (o.has_receiver) {
         layers.push_back({&o.receiver, o.to_volume, o.to_world, glm::dvec4(o.receiver_light_pos),
                           glm::dvec3(o.receiver_light_power), glm::dvec4(o.receiver_light_spot),
-                          o.receiver_light_spot_scale});
+                          o.receiver_light_spot_scale, nullptr, o.receiver_other_lights});
+      }
     if (layers.size() < 2) return;
     glm::dvec3 u, v;
     const glm::dvec3 normal = glm::normalize(scene.ground->normal);

@@ -222,6 +222,10 @@ std::vector<float> receiverTexels(const ReceiverLayer& layer, const std::vector<
           float* out = &rgba[4 * t];
           for (int k = 0; k < 3; ++k) out[k] = map.irradiance[3 * t + static_cast<std::size_t>(k)];
           out[3] = edges ? clearance[t] : 1.0f;
+          if (!layer.other_lights.empty()) {
+            const glm::dvec3 others = otherLightsIrradiance(layer, map.texelCenter(i, j), normal);
+            for (int k = 0; k < 3; ++k) out[k] -= static_cast<float>(others[k]);
+          }
           const double shaded = edges ? 1.0 - litFraction(i, j) : 0.0;
           if (shaded <= 0.0) continue;
           const glm::dvec3 D = bakedDirectIrradiance(layer, map.texelCenter(i, j), normal);

@@ -42,7 +42,8 @@ namespace eik {
 std::vector<float> shadowClearance(const Volume& volume, const ReceiverMap& map, const glm::dvec3& direction);
 
 // The ground's receiver texture of `layer` (its map, the light it was baked with) as RGBA per
-// texel, given its clearance (empty: none, a = 1 and rgb the map).
+// texel, given its clearance (empty: none, a = 1 and rgb the map), less the direct light of the
+// layer's other lights at each texel centre (so that the shader takes off only the first light's).
 std::vector<float> receiverTexels(const ReceiverLayer& layer, const std::vector<float>& clearance);
 
 }  // namespace eik
