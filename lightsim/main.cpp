@@ -80,7 +80,7 @@ int run(int argc, char** argv) {
       "lightsim"};
   app.add_option("input", input,
                  "the volume to bake, IN.vol.json (needs ior and ior_grad; sigma_a if absorbing), or a SCENE.json "
-                 "whose objects are baked each under its placement (its first light, its ground)")
+                 "whose objects are baked each under its placement (every light, summed; its ground)")
       ->required();
   app.add_option("-o,--output", output,
                  "the baked volume, OUT.vol.json (IN plus irradiance and light_dir); for a SCENE.json a folder "
@@ -91,8 +91,8 @@ int run(int argc, char** argv) {
                  "R,G,B: irradiance in W/m² of a directional light, radiant intensity in W/sr of a point light "
                  "(default 1,1,1)");
   app.add_option("--scene", scene_path,
-                 "take the light from this SCENE.json (its first light) instead of --light, and its ground as the "
-                 "receiver");
+                 "take the lights from this SCENE.json (every one, baked in turn and summed) instead of --light, and its "
+                 "ground as the receiver");
   app.add_option("--receiver", receiver_text,
                  "PX,PY,PZ:NX,NY,NZ[:HALF_EXTENT]: a receiver plane through P facing N (the light's side) that "
                  "stops the light and gets its own map of planar irradiance (default: the --scene's ground)");
