@@ -167,7 +167,7 @@ Scene sceneFromJson(const json& j, const std::string& source) {
       std::string path = "lights[" + std::to_string(i) + "]";
       ObjectReader r(lights[i], source, path,
                      {"type", "direction", "irradiance", "position", "intensity", "inner_cone_deg", "outer_cone_deg",
-                      "angular_diameter_deg", "name"});
+                      "angular_diameter_deg", "radius", "name"});
       SceneLightSpec light;
       std::string type = r.string("type", "");
       if (type == "directional") {
@@ -210,7 +210,13 @@ Scene sceneFromJson(const json& j, const std::string& source) {
       if (light.type != SceneLightSpec::Type::Spot && (r.has("inner_cone_deg") || r.has("outer_cone_deg")))
         r.fail(path, "only a spot light has a cone");
       if (light.type != SceneLightSpec::Type::Directional && r.has("angular_diameter_deg"))
-        r.fail(path, "only a directional light has an angular diameter (a point or spot light is a point)");
+        r.fail(path, "only a directional light has an angular diameter (a point or spot light has a radius)");
+      if (r.has("radius")) {
+        if (light.type == SceneLightSpec::Type::Directional)
+          r.fail(path, "only a point or spot light has a radius (a directional light has an angular diameter)");
+        light.radius = r.number("radius", 0.0);
+        if (!(light.radius >= 0.0 && light.radius <= kMaxLightRadius)) r.fail(path + ".radius", "must be in [0, 1000]");
+      }
       scene.lights.push_back(light);
     }
   }
@@ -308,6 +314,7 @@ json sceneToJson(const Scene& s) {
                              {"inner_cone_deg", l.inner_cone_deg},
                              {"outer_cone_deg", l.outer_cone_deg}});
     }
+    if (l.type != SceneLightSpec::Type::Directional && l.radius > 0.0) j["lights"].back()["radius"] = l.radius;
   }
   if (s.ground)
     j["ground"] = {{"point", toJson(s.ground->point)},

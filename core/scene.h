@@ -33,9 +33,14 @@ struct SceneLightSpec {
   // directional: the angle the light's disc spans (the sun's 0.53°; 0: a point at infinity, sharp
   // shadows). Its irradiance comes evenly from the disc: soft shadows (lightsim/sun_disc.h).
   double angular_diameter_deg = 0.0;
+  // point, spot: the radius of the ball that shines (0: a point, sharp shadows). Its light comes
+  // evenly from the disc it shows every receiver: soft shadows (lightsim/sun_disc.h).
+  double radius = 0.0;
 };
 // The largest angular diameter a directional light may have (degrees).
 constexpr double kMaxAngularDiameterDeg = 20.0;
+// The largest radius a point or spot light may have (world units).
+constexpr double kMaxLightRadius = 1e3;
 
 // A spot light's intensity off its axis, as a fraction of the axis' (glTF KHR_lights_punctual):
 // ((cos θ − cos θ_outer)/(cos θ_inner − cos θ_outer))² clamped to [0, 1], θ the angle between the

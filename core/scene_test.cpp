@@ -147,5 +147,22 @@ TEST(Scene, ASunsAngularDiameterRoundTrips) {
     EXPECT_THROW(sceneFromJson(nlohmann::json::parse(bad), "test"), InputError) << bad;
 }
 
+TEST(Scene, APointLightsRadiusRoundTrips) {
+  const Scene scene = sceneFromJson(nlohmann::json::parse(R"({"lights": [{"type": "point", "position": [0, 3, 0],
+      "radius": 0.25}, {"type": "spot", "position": [0, 3, 0], "direction": [0, -1, 0], "radius": 0.5}]})"),
+                                    "test");
+  EXPECT_EQ(scene.lights.at(0).radius, 0.25);
+  EXPECT_EQ(scene.lights.at(1).radius, 0.5);
+  const Scene back = sceneFromJson(sceneToJson(scene), "back");
+  EXPECT_EQ(back.lights.at(0).radius, 0.25);
+  EXPECT_EQ(back.lights.at(1).radius, 0.5);
+  EXPECT_FALSE(sceneToJson(sceneFromJson(nlohmann::json::parse(R"({"lights": [{"type": "point",
+      "position": [0, 1, 0]}]})"), "test"))["lights"][0].contains("radius"));
+  for (const char* bad : {R"({"lights": [{"type": "point", "position": [0, 1, 0], "radius": -1}]})",
+                          R"({"lights": [{"type": "point", "position": [0, 1, 0], "radius": 2000}]})",
+                          R"({"lights": [{"type": "directional", "direction": [0, -1, 0], "radius": 1}]})"})
+    EXPECT_THROW(sceneFromJson(nlohmann::json::parse(bad), "test"), InputError) << bad;
+}
+
 }  // namespace
 }  // namespace eik

@@ -48,14 +48,16 @@ nlohmann::json LightSpec::toJson() const {
     if (angular_diameter_deg > 0.0) j["angular_diameter_deg"] = angular_diameter_deg;
     return j;
   }
+  nlohmann::json j = {{"type", "point"}, {"position", vec3Json(position)}, {"intensity", vec3Json(power)}};
   if (type == Type::Spot)
-    return {{"type", "spot"},
-            {"position", vec3Json(position)},
-            {"direction", vec3Json(direction)},
-            {"intensity", vec3Json(power)},
-            {"inner_cone_deg", inner_cone_deg},
-            {"outer_cone_deg", outer_cone_deg}};
-  return {{"type", "point"}, {"position", vec3Json(position)}, {"intensity", vec3Json(power)}};
+    j = {{"type", "spot"},
+         {"position", vec3Json(position)},
+         {"direction", vec3Json(direction)},
+         {"intensity", vec3Json(power)},
+         {"inner_cone_deg", inner_cone_deg},
+         {"outer_cone_deg", outer_cone_deg}};
+  if (radius > 0.0) j["radius"] = radius;
+  return j;
 }
 
 double LightSpec::attenuation(const glm::dvec3& dir) const {
@@ -326,6 +328,7 @@ std::vector<LightSpec> lightsFromScene(const std::filesystem::path& file) {
       light.direction = l.direction;
       light.inner_cone_deg = l.inner_cone_deg;
       light.outer_cone_deg = l.outer_cone_deg;
+      light.radius = l.radius;
     }
     if (!(light.power.x > 0 || light.power.y > 0 || light.power.z > 0))
       throw InputError(file.string(), "lights[" + std::to_string(i) + "]", "the light has no power");

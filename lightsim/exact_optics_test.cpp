@@ -365,8 +365,13 @@ struct Penumbra {
   double width = 0.0;       // between the 20 % and 80 % levels
   double centre = 0.0;      // where the profile crosses 50 %
 };
-Penumbra penumbraOf(const ReceiverMap& map) {
-  constexpr double kFrom = 0.85, kBin = 0.004;
+// Where penumbraOf looks: the profile from `from` on (0.36 in bins of 0.004), the shadow's level
+// over the radii [inside_lo, inside_hi), the light's over [outside_lo, outside_hi).
+struct PenumbraWindow {
+  double from = 0.85, inside_lo = 0.90, inside_hi = 0.93, outside_lo = 1.10, outside_hi = 1.15;
+};
+Penumbra penumbraOf(const ReceiverMap& map, const PenumbraWindow& window = {}) {
+  const double kFrom = window.from, kBin = 0.004;
   constexpr int kBins = 90;
   std::vector<double> sum(kBins, 0.0), count(kBins, 0.0);
   double inside = 0.0, n_inside = 0.0, outside = 0.0, n_outside = 0.0;
@@ -375,8 +380,8 @@ Penumbra penumbraOf(const ReceiverMap& map) {
       const glm::dvec3 c = map.texelCenter(i, j);
       const double r = std::hypot(c.x, c.z);
       const double e = map.irradiance[3 * (static_cast<std::size_t>(j) * map.texels.x + i) + 1];
-      if (r >= 0.90 && r < 0.93) inside += e, n_inside += 1.0;
-      if (r >= 1.10 && r < 1.15) outside += e, n_outside += 1.0;
+      if (r >= window.inside_lo && r < window.inside_hi) inside += e, n_inside += 1.0;
+      if (r >= window.outside_lo && r < window.outside_hi) outside += e, n_outside += 1.0;
       const int b = static_cast<int>((r - kFrom) / kBin);
       if (b >= 0 && b < kBins) sum[b] += e, count[b] += 1.0;
     }
@@ -439,6 +444,69 @@ TEST(ExactOpticsSoftSun, TheSunsDiscCastsThePenumbraOfGeometry) {
   // Centred on the sharp shadow's edge (r = 1: the disc is symmetric), within a texel (0.0056).
   EXPECT_NEAR(soft.centre, hard.centre, 0.006);
   // Without the disc the edge is a texel or two wide: the penumbra is the disc's.
+  EXPECT_LT(hard.width, 0.3 * geometric);
+}
+
+// A point light with a radius (sun_disc.h ballLightPoints): a ball of radius ρ = 0.3 at height 6
+// over the floor, above the sphere (R = 1, centre 1.5). Every floor point sees it as a uniform
+// disc of radius ρ, so the shadow's edge is a penumbra as under the sun's disc, of angular radius
+// ρ/D_S seen from the silhouette: the cone from the light's centre touches the sphere at
+// D_S = sqrt(4.5² − 1) from it, at β = asin(1/4.5) off the vertical, and meets the floor at
+// D_F = 6/cos β, r = 6 tan β = 1.368; across the ray the penumbra spans 2·x₈₀·ρ·(D_F − D_S)/D_S
+// between its 20 % and 80 % levels (x₈₀ as for the sun), on the floor 1/cos β as much: 0.122.
+// Measured between the light just inside the shadow (r 1.20–1.25, where the sphere's focused light
+// has not reached) and just outside (1.48–1.53), against the point light's sharp edge.
+ReceiverMap bakeSphereUnderABallLight(int res, double light_radius) {
+  const Volume volume = sharpVolume("procedural:sphere,r=1,center=0:1.5:0,ior=1.5", res, std::nullopt, 2.0);
+  CpuSimulator sim(volume);
+  SimulationOptions options = lightsimSharpOptions(volume.grid);
+  options.free_flight = true;
+  options.straight_step_voxels = 2.0;
+  options.volume_deposits = false;
+  ReceiverSpec floor;
+  floor.half_extent = 1.8;
+  floor.pitch_voxels = 0.125;
+  options.receiver = floor;
+  LightSpec lamp;
+  lamp.type = LightSpec::Type::Point;
+  lamp.position = {0.0, 6.0, 0.0};
+  lamp.power = glm::dvec3(36.0);  // 1 W/m² straight below at the floor, as the sun above
+  lamp.radius = light_radius;
+  glm::dvec3 lo, hi;
+  propagationBox(volume.grid, options, lo, hi);
+  LightSpec centre = lamp;
+  centre.radius = 0.0;
+  options.receiver_geometry = receiverGeometry(floor, centre, volume.grid, lo, hi);
+  BandSum sum;
+  for (const LightSpec& point : sunDiscSamples(lamp, kDefaultSunSamples)) sum.add(sim.run(point, options));
+  return sum.finish().receivers.at(0);
+}
+
+TEST(ExactOpticsSoftLight, ABallLightCastsThePenumbraOfGeometry) {
+  constexpr double kRho = 0.3, kHeight = 6.0, kCentre = 1.5;
+  const double d = kHeight - kCentre, beta = std::asin(1.0 / d);
+  const double d_s = std::sqrt(d * d - 1.0), d_f = kHeight / std::cos(beta);
+  double x80 = 0.0;  // f(x) = 0.8 for a straight edge across a uniform disc, by bisection
+  for (double a = 0.0, b = 1.0; b - a > 1e-12; x80 = 0.5 * (a + b)) {
+    const double m = 0.5 * (a + b);
+    (0.5 + (m * std::sqrt(1.0 - m * m) + std::asin(m)) / std::numbers::pi < 0.8 ? a : b) = m;
+  }
+  const double geometric = 2.0 * x80 * kRho * (d_f - d_s) / d_s / std::cos(beta);
+  const PenumbraWindow window{1.15, 1.20, 1.25, 1.48, 1.53};
+  const Penumbra coarse = penumbraOf(bakeSphereUnderABallLight(32, kRho), window);
+  const Penumbra soft = penumbraOf(bakeSphereUnderABallLight(48, kRho), window);
+  const Penumbra hard = penumbraOf(bakeSphereUnderABallLight(48, 0.0), window);
+  std::printf("ball light's penumbra 20-80 %%: %.4f at 32³, %.4f at 48³ (geometric %.4f), its middle at r = %.4f "
+              "(the cone's edge %.4f); the point light's edge %.4f wide\n",
+              coarse.width, soft.width, geometric, soft.centre, kHeight * std::tan(beta), hard.width);
+  // The bound for the sun's penumbra, 10 % of the geometric width, at both resolutions
+  // (measured 0.1254 at 32³ and 0.1253 at 48³, +2.9 %: the 16 points' steps, the edge's curvature).
+  EXPECT_NEAR(coarse.width / geometric, 1.0, 0.10);
+  EXPECT_NEAR(soft.width / geometric, 1.0, 0.10);
+  // Centred on the point light's sharp edge within two texels (0.005 each): the disc is symmetric
+  // to first order (its far side is nearer the silhouette than its near side, by ρ/D_S ≈ 7 %).
+  EXPECT_NEAR(soft.centre, hard.centre, 0.01);
+  EXPECT_NEAR(hard.centre, kHeight * std::tan(beta), 0.01);
   EXPECT_LT(hard.width, 0.3 * geometric);
 }
 

@@ -102,8 +102,8 @@ int run(int argc, char** argv) {
       ->check(CLI::Range(0.01, 8.0));
   app.add_option("--sun-samples", sun_samples,
                  "directions over the disc of a light with an angular size (a scene's directional light with "
-                 "angular_diameter_deg, the sun's 0.53): its soft shadows in that many steps, at that many times "
-                 "the cost (default 16)")
+                 "angular_diameter_deg, the sun's 0.53), or points in the ball of a point or spot light with a "
+                 "radius: its soft shadows in that many steps, at that many times the cost (default 16)")
       ->check(CLI::Range(1, 256));
   app.add_option("--bands", band_count,
                  "spectral bands of a dispersive volume (a dispersion field or a slot with a Cauchy B), each "
@@ -281,9 +281,14 @@ int run(int argc, char** argv) {
       runs += bands.size() * l.directions.size();
       point_like.push_back(l.light);
       point_like.back().angular_diameter_deg = 0.0;
-      if (l.directions.size() > 1 && !quiet)
-        std::fprintf(stderr, "lightsim: a light's disc of %.3g degrees from %zu directions (soft shadows)\n",
-                     l.light.angular_diameter_deg, l.directions.size());
+      if (l.directions.size() > 1 && !quiet) {
+        if (l.light.type == LightSpec::Type::Directional)
+          std::fprintf(stderr, "lightsim: a light's disc of %.3g degrees from %zu directions (soft shadows)\n",
+                       l.light.angular_diameter_deg, l.directions.size());
+        else
+          std::fprintf(stderr, "lightsim: a light's ball of radius %.3g from %zu points in it (soft shadows)\n",
+                       l.light.radius, l.directions.size());
+      }
     }
     // Runs that are summed share one map lattice: the union of the lights' own.
     if (options.receiver && runs > 1) {

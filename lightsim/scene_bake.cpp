@@ -62,6 +62,7 @@ void bakeToVolumeFrame(BakeResult& result, LightSpec& light, double scale) {
     map.pitch /= scale;
   }
   light.position /= scale;
+  light.radius /= scale;
 }
 
 namespace {

@@ -39,6 +39,9 @@ struct LightSpec {
   // Directional: the disc's angular diameter (soft shadows). A run takes the light as a point at
   // infinity; a bake samples the disc (lightsim/sun_disc.h) and sums the runs.
   double angular_diameter_deg = 0.0;
+  // Point, spot: the radius of the ball that shines (soft shadows); a run takes the light as a
+  // point; a bake samples the ball (lightsim/sun_disc.h) and sums the runs.
+  double radius = 0.0;
   nlohmann::json toJson() const;         // as a SCENE.json light
   // The fraction of `power` a point or spot light sends along the unit direction `dir` (1 but off
   // a spot's axis).

@@ -16,7 +16,17 @@ namespace eik {
 constexpr int kDefaultSunSamples = 16;
 
 // The light as `samples` point-like lights over its disc (angular_diameter_deg 0 each), their power
-// summing to the light's. A light without an angular size (or not directional) is itself, alone.
+// summing to the light's; a point or spot light with a radius, as `samples` points in its ball
+// (ballLightPoints). A light without an angular size or a radius is itself, alone.
 std::vector<LightSpec> sunDiscSamples(const LightSpec& light, int samples);
+
+// A point or spot light of radius ρ (a ball whose surface shines evenly: every receiver sees a
+// uniform disc of radius ρ facing it) as `samples` points in the ball, each with 1/K of the
+// intensity, that look like that disc from every side at once: their radii have the density
+// ∝ r²/sqrt(ρ² − r²), whose projection along any direction is uniform over the disc (the Abel
+// transform of 1/sqrt(ρ² − r²) is constant). Stratified: r_i = ρ sin u_i at the quantiles (i + ½)/K
+// of (u − sin u cos u)/(π/2), the directions at height z_i = 1 − 2·(the base-2 radical inverse of
+// i + ½/K) and azimuth i·137.5°, so that radius, height and azimuth do not follow one another.
+std::vector<glm::dvec3> ballLightPoints(double radius, int samples);
 
 }  // namespace eik

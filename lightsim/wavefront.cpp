@@ -689,6 +689,7 @@ void validateLight(const LightSpec& light) {
   }
   if (!(light.angular_diameter_deg >= 0.0 && light.angular_diameter_deg <= kMaxAngularDiameterDeg))
     throw InputError("light", "angular_diameter_deg", "must be in [0, 20] degrees");
+  if (!(light.radius >= 0.0 && std::isfinite(light.radius))) throw InputError("light", "radius", "must be finite, >= 0");
   if (light.type == LightSpec::Type::Spot) {
     if (!finite3(light.direction) || glm::length(light.direction) == 0.0)
       throw InputError("light", "direction", "a spot light's axis must be a finite, non-zero vector");

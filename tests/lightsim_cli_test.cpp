@@ -487,6 +487,19 @@ TEST(LightsimCli, ASunWithADiscBakesSoftShadows) {
     ProgramResult v = runProgram(VIEWER_EXE, {"out/SCENE.json", "--render", "soft.png", "--size", "48x32"}, dir.path());
     EXPECT_EQ(v.exit_code, 0) << v.output;
   }
+  // A point light with a radius, on an object the scene scales by 2: points in its ball, and the
+  // radius in the volume's own units in the manifest (0.4 / 2).
+  writeFile(dir / "SCENE.json", R"({
+    "lights": [{"type": "point", "position": [0, 3, 0], "intensity": [9, 9, 9], "radius": 0.4}],
+    "ground": {"point": [0, -1.2, 0], "normal": [0, 1, 0], "half_extent": 3},
+    "objects": [{"volume": "sharp.vol.json", "scale": 2}]})");
+  ProgramResult r = runProgram(LIGHTSIM_EXE, {"SCENE.json", "-o", "lamp", "--sun-samples", "5"}, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("ball of radius 0.4 from 5 points"), std::string::npos) << r.output;
+  const Volume baked = readVolume(dir / "lamp" / "sharp.baked.vol.json");
+  EXPECT_NEAR(baked.metadata["light"].value("radius", 0.0), 0.2, 1e-12);
+  ProgramResult v = runProgram(VIEWER_EXE, {"lamp/SCENE.json", "--render", "lamp.png", "--size", "48x32"}, dir.path());
+  EXPECT_EQ(v.exit_code, 0) << v.output;
 }
 
 // Ctrl-C (SIGINT) or a kill (SIGTERM) during a bake: exit 130 / 143, a message, and no output file
