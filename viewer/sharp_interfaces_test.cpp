@@ -356,6 +356,56 @@ TEST_F(SharpViewerTest, TotalReflectionAtAFaceRestingOnTheGroundNeverShowsTheGro
   EXPECT_GT(darkest, 0.5f);
 }
 
+// A reflection sees the ground (object.glsl branchRadiance): a block of black glass (n = 1.5,
+// σa = 400: nothing comes through) stands in the sun (vertical, E = 1) over a white ground
+// (ρ = 0.8) under a black sky; its vertical face z = 0.2, seen from above 30° below the horizontal,
+// mirrors the ray down onto the ground in the open, which shines ρE/π. So the face shows
+// R(30°)·ρE/π, R the exact Fresnel reflectance at the 30° incidence (0.0415) — with sharp interfaces
+// (the crossing's other branch), with a smoothed n (the boundary layer's reflection, at the normal
+// where |∇n| peaks) and with the glass touching the volume's box (the face the box cuts). A
+// reflection that saw only the sky would be black.
+TEST_F(SharpViewerTest, AReflectionSeesTheGround) {
+  const double theta = glm::radians(30.0);  // incidence on the face, and the view's angle below the horizontal
+  const double expected = reference::fresnelReflectance(1.0, 1.5, std::cos(theta)) * 0.8 / std::numbers::pi;
+  const std::string glass = "procedural:box,size=0.4,center=0:0.5:0,ior=1.5,sigma_a=400:400:400";
+  struct Case {
+    const char* name;
+    Volume volume;
+    double tolerance;
+  };
+  std::vector<Case> cases;
+  // Sharp faces: the crossing's Fresnel is exact; 2 % for the float march and the face found to a
+  // fraction of a voxel.
+  cases.push_back({"sharp", sharpVolume(glass, 48, box({-0.3, 0.2, -0.3}, {0.3, 0.8, 0.3})), 0.02});
+  cases.push_back({"touching the box", sharpVolume(glass, 48, box({-0.3, 0.3, -0.3}, {0.3, 0.7, 0.2})), 0.02});
+  // A smoothed n: the layer's normal from ∇n, whose direction the Gaussian keeps on a flat face
+  // away from its edges; 5 % for the peak's placement in the layer.
+  cases.push_back({"smoothed", test_scenes::proceduralVolume(glass, 48, box({-0.3, 0.2, -0.3}, {0.3, 0.8, 0.3})), 0.05});
+  for (Case& c : cases) {
+    Scene scene;
+    scene.objects.push_back({});
+    SceneGroundSpec ground;
+    ground.albedo = glm::dvec3(0.8);
+    ground.half_extent = 10.0;
+    scene.ground = ground;
+    scene.environment.uniform = glm::dvec3(0.0);
+    SceneLightSpec sun;  // straight down, E = 1
+    scene.lights = {sun};
+    LoadedScene loaded = sceneFromVolumes(scene, {std::move(c.volume)});
+    loaded.scene.lights = {sun};
+    SceneRenderer renderer(*shaders_, loaded, RenderSettings{});
+    // Onto (0, 0.55) of the face z = 0.2, 30° below the horizontal; mirrored, 30° down towards +z,
+    // meeting the ground at z = 0.2 + 0.55·√3 = 1.15, far from the block's footprint.
+    const glm::dvec3 d = glm::normalize(glm::dvec3(0.0, -std::sin(theta), -std::cos(theta))), target(0.0, 0.55, 0.2);
+    const Image image = renderer.render(lookAlong(target - 1.0 * d, d, 1.0), {8, 8});
+    double mean = 0.0;
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 8; ++x) mean += image.at(x, y)[1] / 64.0;
+    std::printf("%s: the face shows %.5f, R·ρE/π = %.5f\n", c.name, mean, expected);
+    EXPECT_NEAR(mean, expected, c.tolerance * expected) << c.name;
+  }
+}
+
 // Two absorbing, scattering glasses stacked along the view (A: z in [0, 0.5], n 1.5; B: z in
 // [−0.5, 0], n 1.7; each its own slot, each σa and ω̂ one constant: slotMedia finds them, and the
 // march reads them by the material it is in), under a uniform baked light E along l, black sky,

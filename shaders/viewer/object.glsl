@@ -18,6 +18,10 @@ uniform sampler3D uO@Bricks;  // homogeneousBricks (viewer/volume_analysis.h), n
 uniform sampler2D uO@Receiver;  // the receiver map of the ground (core/receiver_map.h), RGB W/m²
 #endif
 
+// The light a reflection (or any branch the march does not follow) sees: the ground or the
+// environment (defined below, after the ground's helpers it uses).
+vec3 branchRadiance@(vec3 pVol, vec3 dVol);
+
 // The state of a ray inside this object, in the volume's own space.
 struct March@ {
   vec3 x;           // position
@@ -170,8 +174,8 @@ void crossBoundary@(inout Ray r, float n1, float n2, vec3 dIn, vec3 gradPeak, ve
     // The volume's reflection tint (none without a reflect field: weight 0).
     vec4 reflectTint = volumeReflect(uvwPeak);
     vec3 tint = mix(vec3(1.0), reflectTint.rgb, clamp(reflectTint.a, 0.0, 1.0));
-    vec3 reflected = normalize(mat3(uObjVolToWorld[@]) * reflect(dIn, normal));
-    r.radiance += TBefore * R * tint * environmentRadiance(reflected, uReflectionLod);
+    vec3 pPeak = uObjBoundsMin[@] + uvwPeak * (uObjBoundsMax[@] - uObjBoundsMin[@]);
+    r.radiance += TBefore * R * tint * branchRadiance@(pPeak, reflect(dIn, normal));
   }
 #endif
 }
@@ -241,7 +245,7 @@ void enterSharpFace@(inout Ray r, inout March@ m) {
     outward = normalize(outward);
 #ifdef FRESNEL
     float R = fresnelReflectance(1.0, m.n, abs(dot(d, outward)));
-    r.radiance += r.T * R * environmentRadiance(normalize(mat3(uObjVolToWorld[@]) * reflect(d, outward)), uReflectionLod);
+    r.radiance += r.T * R * branchRadiance@(m.x, reflect(d, outward));
     r.T *= 1.0 - R;
 #endif
     d = refract(d, outward, 1.0 / m.n);
