@@ -398,17 +398,26 @@ Penumbra penumbraOf(const ReceiverMap& map, const PenumbraWindow& window = {}) {
   return {crossing(0.8) - crossing(0.2), crossing(0.5)};
 }
 
-ReceiverMap bakeSphereUnderTheSunsDisc(int res, double angular_diameter_deg) {
-  const Volume volume = sharpVolume("procedural:sphere,r=1,center=0:1.5:0,ior=1.5", res, std::nullopt, 2.0);
-  CpuSimulator sim(volume);
+// The options of a soft-shadow bake of the sphere over the floor: as lightsim bakes a clear object
+// over a ground (free flight, straight steps, the map only), the floor's map at an eighth of a
+// voxel over [−half_extent, half_extent]².
+SimulationOptions softShadowOptions(const Volume& volume, double half_extent) {
   SimulationOptions options = lightsimSharpOptions(volume.grid);
   options.free_flight = true;
   options.straight_step_voxels = 2.0;
   options.volume_deposits = false;
   ReceiverSpec floor;
-  floor.half_extent = 1.6;
+  floor.half_extent = half_extent;
   floor.pitch_voxels = 0.125;
   options.receiver = floor;
+  return options;
+}
+
+ReceiverMap bakeSphereUnderTheSunsDisc(int res, double angular_diameter_deg) {
+  const Volume volume = sharpVolume("procedural:sphere,r=1,center=0:1.5:0,ior=1.5", res, std::nullopt, 2.0);
+  CpuSimulator sim(volume);
+  SimulationOptions options = softShadowOptions(volume, 1.6);
+  const ReceiverSpec floor = *options.receiver;
   LightSpec sun;  // straight down, irradiance 1
   sun.angular_diameter_deg = angular_diameter_deg;
   glm::dvec3 lo, hi;
@@ -459,14 +468,8 @@ TEST(ExactOpticsSoftSun, TheSunsDiscCastsThePenumbraOfGeometry) {
 ReceiverMap bakeSphereUnderABallLight(int res, double light_radius) {
   const Volume volume = sharpVolume("procedural:sphere,r=1,center=0:1.5:0,ior=1.5", res, std::nullopt, 2.0);
   CpuSimulator sim(volume);
-  SimulationOptions options = lightsimSharpOptions(volume.grid);
-  options.free_flight = true;
-  options.straight_step_voxels = 2.0;
-  options.volume_deposits = false;
-  ReceiverSpec floor;
-  floor.half_extent = 1.8;
-  floor.pitch_voxels = 0.125;
-  options.receiver = floor;
+  SimulationOptions options = softShadowOptions(volume, 1.8);
+  const ReceiverSpec floor = *options.receiver;
   LightSpec lamp;
   lamp.type = LightSpec::Type::Point;
   lamp.position = {0.0, 6.0, 0.0};
