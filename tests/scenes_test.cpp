@@ -34,8 +34,8 @@ std::vector<std::string> assetScenes() {
 TEST(AssetScenes, ThereAreTheThesisScenes) {
   const std::vector<std::string> names = assetScenes();
   for (const char* name :
-       {"amber_bunny", "glass_sphere", "layered_cube", "logo_block", "museum", "prism", "prism_caustic",
-        "sphere_ring", "wine_glass", "wine_glass_point"})
+       {"amber_bunny", "colored_lights", "glass_sphere", "layered_cube", "logo_block", "museum", "prism",
+        "prism_caustic", "sphere_ring", "wine_glass", "wine_glass_point"})
     EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
 }
 
