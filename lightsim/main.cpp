@@ -446,10 +446,13 @@ int run(int argc, char** argv) {
     const bool dispersive = std::any_of(volumes.begin(), volumes.end(), [](const Volume& v) { return isDispersive(v); });
     const std::vector<SpectralBand> bands = dispersive ? spectralBands(band_count) : spectralBands(1);
     // Every light in turn, each with the objects in the order it meets them and a chain per run
-    // (band × direction of its disc); each object's bakes under the lights summed, then written.
+    // (band × direction of its disc); each object's bakes under the lights summed, and written
+    // (its volume, simulator and sums let go) after the last light's run: with one light, one object
+    // at a time holds its memory, as before several lights were baked.
     const std::vector<BakeLight> lights = bakeLights(world_lights);
     std::vector<std::vector<BakeLight>> object_lights(volumes.size());  // in each object's bake frame
-    std::vector<std::unique_ptr<VolumeBake>> bakes;
+    std::vector<SimulationOptions> object_options(volumes.size(), options);
+    std::vector<std::unique_ptr<VolumeBake>> bakes(volumes.size());  // made at an object's first run
     for (std::size_t i = 0; i < volumes.size(); ++i) {
       const BakeFrame frame = BakeFrame::of(scene.objects[i]);
       for (const BakeLight& l : lights) {
@@ -457,10 +460,10 @@ int run(int argc, char** argv) {
         for (const LightSpec& direction : l.directions) in_frame.directions.push_back(frame.light(direction));
         object_lights[i].push_back(in_frame);
       }
-      SimulationOptions object_options = options;
-      if (ground) object_options.receiver = frame.receiver(*ground);
-      bakes.push_back(prepare(volumes[i], sources[i], object_lights[i], object_options, frame.scale, bands));
+      if (ground) object_options[i].receiver = frame.receiver(*ground);
     }
+    fs::create_directories(out_dir);
+    Scene baked = scene;
     std::vector<BandSum> sums(volumes.size());
     for (std::size_t l = 0; l < lights.size(); ++l) {
       std::vector<SceneLightChain> chains;
@@ -493,18 +496,19 @@ int run(int argc, char** argv) {
             std::fprintf(stderr, "lightsim: %zu of the light's cells (%.4g W) in their shade\n", x.left_out,
                          luminance(x.flux_left_out));
         };
+        if (!bakes[i])
+          bakes[i] = prepare(volumes[i], sources[i], object_lights[i], object_options[i],
+                             BakeFrame::of(scene.objects[i]).scale, bands);
         ProgressBar bar("lightsim", !quiet);
         sums[i].add(runLight(*bakes[i], object_lights[i][l], bands, hooks, bar.callback()));
         bar.finish();
+        if (l + 1 < lights.size()) continue;
+        write(*bakes[i], sums[i].finish(), object_lights[i], bands, (out_dir / names[i]).string(), "", nlohmann::json());
+        bakes[i].reset();
+        sums[i] = BandSum();
+        volumes[i] = Volume();
+        baked.objects[i].volume = names[i];
       }
-    }
-    fs::create_directories(out_dir);
-    Scene baked = scene;
-    for (std::size_t i = 0; i < volumes.size(); ++i) {
-      write(*bakes[i], sums[i].finish(), object_lights[i], bands, (out_dir / names[i]).string(), "", nlohmann::json());
-      bakes[i].reset();
-      volumes[i] = Volume();
-      baked.objects[i].volume = names[i];
     }
     if (!scene.environment.file.empty()) {
       const fs::path from = scene.resolve("environment.file", scene.environment.file);
