@@ -126,7 +126,7 @@ glm::dmat4 objectToWorld(const SceneObjectSpec& o) {
   m = glm::rotate(m, glm::radians(o.rotate_deg.z), glm::dvec3(0, 0, 1));
   m = glm::rotate(m, glm::radians(o.rotate_deg.y), glm::dvec3(0, 1, 0));
   m = glm::rotate(m, glm::radians(o.rotate_deg.x), glm::dvec3(1, 0, 0));
-  return glm::scale(m, glm::dvec3(o.scale));
+  return glm::scale(m, o.scale);
 }
 
 Scene sceneFromJson(const json& j, const std::string& source) {
@@ -244,8 +244,9 @@ Scene sceneFromJson(const json& j, const std::string& source) {
       o.volume = r.string("volume", "");
       o.translate = r.vec3("translate", o.translate);
       o.rotate_deg = r.vec3("rotate_deg", o.rotate_deg);
-      o.scale = r.number("scale", 1.0);
-      if (!(o.scale > 0)) r.fail(path + ".scale", "must be positive");
+      // One number (uniform) or [x, y, z] along the volume's own axes.
+      o.scale = r.has("scale") && r.at("scale").is_array() ? r.vec3("scale", o.scale) : glm::dvec3(r.number("scale", 1.0));
+      if (!(o.scale.x > 0 && o.scale.y > 0 && o.scale.z > 0)) r.fail(path + ".scale", "must be positive");
       scene.objects.push_back(o);
     }
   }
@@ -326,7 +327,7 @@ json sceneToJson(const Scene& s) {
     j["objects"].push_back({{"volume", o.volume},
                             {"translate", toJson(o.translate)},
                             {"rotate_deg", toJson(o.rotate_deg)},
-                            {"scale", o.scale}});
+                            {"scale", o.uniformScale() ? json(o.scale.x) : toJson(o.scale)}});
   j["render"] = {{"size", {s.render.size.x, s.render.size.y}},
                  {"step_voxels", s.render.step_voxels},
                  {"exposure", s.render.exposure},

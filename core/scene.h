@@ -83,7 +83,9 @@ struct SceneObjectSpec {
   std::string volume;                  // path as written in the file (relative to the scene file)
   glm::dvec3 translate{0.0};
   glm::dvec3 rotate_deg{0.0};          // XYZ Euler angles in degrees, applied X then Y then Z
-  double scale = 1.0;
+  glm::dvec3 scale{1.0};               // along the volume's own x, y, z (one number in the file when equal)
+
+  bool uniformScale() const { return scale.x == scale.y && scale.y == scale.z; }
 };
 
 struct SceneRenderSpec {

@@ -164,5 +164,36 @@ TEST(Scene, APointLightsRadiusRoundTrips) {
     EXPECT_THROW(sceneFromJson(nlohmann::json::parse(bad), "test"), InputError) << bad;
 }
 
+// An object's scale: one number (uniform, written back as one) or [x, y, z] along the volume's own
+// axes, which objectToWorld applies before the turn.
+TEST(Scene, AnObjectsScaleAlongItsAxesRoundTrips) {
+  const Scene scene = sceneFromJson(nlohmann::json::parse(R"({"objects": [{"volume": "a", "scale": 2},
+      {"volume": "b", "scale": [1.5, 0.75, 1.2], "rotate_deg": [0, 90, 0]}]})"),
+                                    "test");
+  EXPECT_TRUE(scene.objects[0].uniformScale());
+  EXPECT_EQ(scene.objects[0].scale, glm::dvec3(2.0));
+  EXPECT_FALSE(scene.objects[1].uniformScale());
+  EXPECT_EQ(scene.objects[1].scale, glm::dvec3(1.5, 0.75, 1.2));
+  const nlohmann::json j = sceneToJson(scene);
+  EXPECT_TRUE(j["objects"][0]["scale"].is_number());
+  EXPECT_TRUE(j["objects"][1]["scale"].is_array());
+  EXPECT_EQ(sceneFromJson(j, "back").objects[1].scale, glm::dvec3(1.5, 0.75, 1.2));
+  // The volume's x (scaled 1.5) turned 90° about y lies along world −z.
+  const glm::dvec3 x = glm::dmat3(objectToWorld(scene.objects[1])) * glm::dvec3(1.0, 0.0, 0.0);
+  EXPECT_NEAR(glm::length(x - glm::dvec3(0.0, 0.0, -1.5)), 0.0, 1e-12);
+  const glm::dvec3 y = glm::dmat3(objectToWorld(scene.objects[1])) * glm::dvec3(0.0, 1.0, 0.0);
+  EXPECT_NEAR(glm::length(y - glm::dvec3(0.0, 0.75, 0.0)), 0.0, 1e-12);
+  for (const char* bad : {R"({"objects": [{"volume": "a", "scale": [1, 0, 1]}]})",
+                          R"({"objects": [{"volume": "a", "scale": [1, 2]}]})",
+                          R"({"objects": [{"volume": "a", "scale": "big"}]})"}) {
+    EXPECT_THROW(sceneFromJson(nlohmann::json::parse(bad), "test"), InputError) << bad;
+    try {
+      sceneFromJson(nlohmann::json::parse(bad), "test");
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("objects[0].scale"), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace eik

@@ -306,7 +306,7 @@ TEST(ExactOpticsSphere, CausticOnTheFloorConvergesToExactOptics) {
 // wide, either far beyond these bounds.
 SphereBake bakePlacedSphereOnFloor(int res) {
   SceneObjectSpec placement;
-  placement.scale = 1.5;
+  placement.scale = glm::dvec3(1.5);
   placement.rotate_deg = {20.0, 40.0, 0.0};
   const glm::dvec3 centre_in_volume(0.3, 0.2, -0.1);
   placement.translate = glm::dvec3(0.0, 1.5, 0.0) - glm::dvec3(objectToWorld(placement) * glm::dvec4(centre_in_volume, 1.0));

@@ -394,7 +394,7 @@ int run(int argc, char** argv) {
         throw InputError("command line", flag,
                          std::string("not with a SCENE.json input: the scene gives the light and the ground, and each "
                                      "baked manifest holds its bake's stats"));
-    const Scene scene = readScene(input);
+    Scene scene = readScene(input);
     const fs::path out_dir = fs::absolute(output).lexically_normal();
     if (!fs::is_directory(out_dir.parent_path()))
       throw InputError("-o", output, "directory " + out_dir.parent_path().string() + " does not exist");
@@ -416,6 +416,10 @@ int run(int argc, char** argv) {
       volumes.back().require("ior", 1, sources.back());
       volumes.back().require("ior_grad", 3, sources.back());
       interfaceTable(volumes.back(), sources.back());
+      // Scaled differently along its axes: baked (and written) as the volume at world scale along
+      // each axis, placed with scale 1 in the baked SCENE.json (scene_bake.h takeInAxisScale); the
+      // maps it held are baked anew.
+      takeInAxisScale(volumes.back(), scene.objects[i]);
       std::string stem = path.filename().string();
       for (const char* suffix : {".vol.json", ".json"})
         if (stem.size() > std::strlen(suffix) && stem.ends_with(suffix)) {

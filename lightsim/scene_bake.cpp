@@ -4,13 +4,18 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <stdexcept>
 
 #include "core/interfaces.h"
 #include "lightsim/receiver.h"
 
 namespace eik {
 
-BakeFrame BakeFrame::of(const SceneObjectSpec& object) { return of(objectToWorld(object)); }
+BakeFrame BakeFrame::of(const SceneObjectSpec& object) {
+  if (!object.uniformScale())
+    throw std::invalid_argument("BakeFrame::of: an object scaled differently along its axes (takeInAxisScale first)");
+  return of(objectToWorld(object));
+}
 
 BakeFrame BakeFrame::of(const glm::dmat4& object_to_world) {
   const glm::dmat3 linear(object_to_world);
@@ -53,6 +58,87 @@ Volume volumeAtWorldScale(const Volume& volume, double scale) {
     scaled.metadata["interfaces"] = table.toJson();
   }
   return scaled;
+}
+
+Volume volumeAtWorldScale(const Volume& volume, const glm::dvec3& scale, std::vector<std::string>* dropped) {
+  if (scale.x == scale.y && scale.y == scale.z) return volumeAtWorldScale(volume, scale.x);
+  Volume scaled = volume;
+  scaled.field_files.clear();  // the data changes: nothing is copied from the files read
+  scaled.grid.bounds_min *= scale;
+  scaled.grid.bounds_max *= scale;
+  const auto perAxis = [](Field& field, const glm::dvec3& factor, bool renormalise) {
+    if (field.components != 3) return;
+    for (std::size_t i = 0; i + 2 < field.data.size(); i += 3) {
+      glm::dvec3 v(field.data[i], field.data[i + 1], field.data[i + 2]);
+      const double length = glm::length(v);
+      v *= factor;
+      if (renormalise && length > 0.0) v *= length / glm::length(v);
+      for (int c = 0; c < 3; ++c) field.data[i + c] = static_cast<float>(v[c]);
+    }
+  };
+  if (auto it = scaled.fields.find("ior_grad"); it != scaled.fields.end()) perAxis(it->second, 1.0 / scale, false);
+  if (auto it = scaled.fields.find("light_dir"); it != scaled.fields.end()) perAxis(it->second, scale, true);
+  const double shortest = std::min(scale.x, std::min(scale.y, scale.z));
+  if (auto it = scaled.fields.find("interfaces"); it != scaled.fields.end()) {
+    for (float& v : it->second.data) v = static_cast<float>(v * shortest);
+    InterfaceTable table = interfaceTable(volume);
+    table.band *= shortest;
+    scaled.metadata["interfaces"] = table.toJson();
+  }
+  // A map's plane p = point + a·u + b·v goes to S·point + a·S·u + b·S·v: a square lattice again
+  // when S·u and S·v are as long as each other and still perpendicular.
+  std::vector<ReceiverMap> kept;
+  for (ReceiverMap map : scaled.receivers) {
+    const glm::dvec3 su = scale * map.u, sv = scale * map.v;
+    const double stretch = glm::length(su);
+    if (std::abs(glm::length(sv) - stretch) > 1e-9 * stretch || std::abs(glm::dot(su, sv)) > 1e-9 * stretch * stretch) {
+      if (dropped) dropped->push_back(map.name);
+      continue;
+    }
+    map.point *= scale;
+    map.u = su / stretch;
+    map.v = sv / stretch;
+    map.normal = glm::normalize(map.normal / scale);
+    map.origin *= stretch;
+    map.pitch *= stretch;
+    kept.push_back(std::move(map));
+  }
+  scaled.receivers = std::move(kept);
+  // The light the volume was baked with, in its coordinates: a position to S·p, a direction along
+  // S·d, a ball's radius × the mean stretch (an ellipsoid has none).
+  const auto carryLight = [&](nlohmann::json& light) {
+    if (!light.is_object()) return;
+    const auto vec = [&](const char* key, bool direction) {
+      const auto it = light.find(key);
+      if (it == light.end() || !it->is_array() || it->size() != 3) return;
+      glm::dvec3 v;
+      for (int c = 0; c < 3; ++c) {
+        if (!(*it)[c].is_number()) return;
+        v[c] = (*it)[c].get<double>();
+      }
+      v *= scale;
+      if (direction && glm::length(v) > 0.0) v = glm::normalize(v);
+      *it = nlohmann::json::array({v.x, v.y, v.z});
+    };
+    vec("position", false);
+    vec("direction", true);
+    if (const auto it = light.find("radius"); it != light.end() && it->is_number())
+      *it = it->get<double>() * std::cbrt(scale.x * scale.y * scale.z);
+  };
+  if (auto it = scaled.metadata.find("light"); it != scaled.metadata.end()) carryLight(*it);
+  if (auto it = scaled.metadata.find("lights"); it != scaled.metadata.end() && it->is_array())
+    for (nlohmann::json& light : *it) carryLight(light);
+  return scaled;
+}
+
+bool takeInAxisScale(Volume& volume, SceneObjectSpec& object, const std::function<void(const std::string&)>& warn) {
+  if (object.uniformScale()) return false;
+  std::vector<std::string> dropped;
+  volume = volumeAtWorldScale(volume, object.scale, &dropped);
+  object.scale = glm::dvec3(1.0);
+  if (warn)
+    for (const std::string& map : dropped) warn(map);
+  return true;
 }
 
 void bakeToVolumeFrame(BakeResult& result, LightSpec& light, double scale) {

@@ -9,9 +9,17 @@
 // voxels of the scaled grid) needs no conversion; the volume's own lengths scale: the grid's box
 // and the interfaces' signed distances (and band) by s, ∇n by 1/s. Refraction is unchanged by a
 // uniform scale, so the same rays bend the same way, only s times as long.
+//
+// An object scaled by different factors along its axes is first taken in as a volume of its own
+// (takeInAxisScale): the volume at world scale along each axis, on voxels as long as the scale
+// makes them, placed by T · R alone. Programs do that where they read a scene's object, so that
+// everything after it (the bake frame, the chain from box to box, the viewer's march) sees an
+// object of uniform scale 1.
 #pragma once
 
 #include <cstddef>
+#include <functional>
+#include <string>
 #include <optional>
 #include <vector>
 
@@ -29,6 +37,7 @@ struct BakeFrame {
   glm::dvec3 origin{0.0};    // the bake frame's origin in the world (T)
   double scale = 1.0;        // the object's uniform scale s
 
+  // std::invalid_argument for an object scaled differently along its axes (takeInAxisScale first).
   static BakeFrame of(const SceneObjectSpec& object);
   // From a placement matrix translate · rotation · uniform scale (objectToWorld's).
   static BakeFrame of(const glm::dmat4& object_to_world);
@@ -40,6 +49,23 @@ struct BakeFrame {
 // The volume as its bake frame sees it (above): the grid's box × s, `interfaces` and the table's
 // band × s, `ior_grad` ÷ s; every other field as it is. `scale` 1 copies the volume unchanged.
 Volume volumeAtWorldScale(const Volume& volume, double scale);
+
+// The volume scaled by S = diag(sx, sy, sz) about its origin, p' = S·p: the grid's box × S (its
+// voxels S times as long per axis), ∇n ÷ S per component (n(S⁻¹p') differentiated), `light_dir`
+// along S·d (renormalised), the interfaces' signed distances and band × min(s): a distance field
+// stretched unevenly is no distance any more, but its zero set (the surface) and its gradient's
+// direction (the normal, S⁻¹·∇d) are exact, which is all that crossings read, and × min(s) keeps
+// every value a lower bound of the true distance (the band's "at least this far" stays true).
+// Receiver maps baked with the volume follow when the scale is the same along their plane (their
+// lattice stays square); `dropped` receives the names of those that cannot. For equal factors this
+// is volumeAtWorldScale. Fields other programs wrote stay as they are.
+Volume volumeAtWorldScale(const Volume& volume, const glm::dvec3& scale, std::vector<std::string>* dropped = nullptr);
+
+// An object of a scene scaled differently along its axes, taken in as the volume at world scale
+// along each axis (above) placed with scale 1; false, and nothing changed, for a uniform scale.
+// `warn` is told of each receiver map left out (a baked ground that cannot follow the scale).
+bool takeInAxisScale(Volume& volume, SceneObjectSpec& object,
+                     const std::function<void(const std::string& map)>& warn = {});
 
 // A bake made in the bake frame, back in the volume's own coordinates: each receiver map's point,
 // origin and pitch ÷ s (its irradiance, W/m², stays), and a point light's position ÷ s.

@@ -20,7 +20,7 @@ SceneObjectSpec placement() {
   SceneObjectSpec object;
   object.translate = {0.4, -1.0, 2.0};
   object.rotate_deg = {10.0, -35.0, 60.0};
-  object.scale = 2.5;
+  object.scale = glm::dvec3(2.5);
   return object;
 }
 
@@ -84,6 +84,75 @@ TEST(BakeFrame, TheVolumeAtWorldScale) {
   EXPECT_EQ(result.receivers[0].irradiance, map.irradiance);
 }
 
+// Scaled along its axes by S = diag(1.5, 0.75, 1.5): the box × S, ∇n ÷ S, light_dir along S·d
+// (unit), distances and band × 0.75 (the shortest), the baked map (on a plane y = const, where S
+// is 1.5 both ways) carried with its lattice and the baked light's position and direction; with
+// 1.5 : 0.75 : 1.2 the map cannot stay square and is left out, named.
+TEST(BakeFrame, TheVolumeAtWorldScaleAlongItsAxes) {
+  Volume volume = test_scenes::sharpVolume("procedural:sphere,r=0.5,center=0.1:0:0,ior=1.5", 16);
+  Field& grad = volume.fields.at("ior_grad");
+  for (std::size_t i = 0; i < grad.data.size(); ++i) grad.data[i] = static_cast<float>(1 + i % 3);
+  Field& dir = volume.addField("light_dir", 3);
+  for (std::size_t i = 0; i < dir.data.size(); i += 3) {
+    dir.data[i] = 0.6f;
+    dir.data[i + 2] = -0.8f;
+  }
+  ReceiverMap map;
+  map.point = {0.2, -1.0, 0.1};
+  map.origin = {-2.0, -3.0};
+  map.pitch = 0.05;
+  map.texels = {1, 1};
+  map.irradiance = {1.0f, 2.0f, 3.0f};
+  volume.receivers.push_back(map);
+  volume.metadata["light"] = {{"type", "spot"}, {"position", {1.0, 2.0, 3.0}}, {"direction", {0.0, -0.6, 0.8}}};
+  const glm::dvec3 s(1.5, 0.75, 1.5);
+  std::vector<std::string> dropped;
+  const Volume scaled = volumeAtWorldScale(volume, s, &dropped);
+  EXPECT_TRUE(dropped.empty());
+  EXPECT_EQ(scaled.grid.dims, volume.grid.dims);
+  EXPECT_NEAR(glm::length(scaled.grid.bounds_min - s * volume.grid.bounds_min), 0.0, 1e-12);
+  EXPECT_NEAR(glm::length(scaled.grid.bounds_max - s * volume.grid.bounds_max), 0.0, 1e-12);
+  EXPECT_NEAR(interfaceTable(scaled).band, 0.75 * interfaceTable(volume).band, 1e-12);
+  for (std::size_t i = 0; i < grad.data.size(); i += 31)
+    EXPECT_FLOAT_EQ(scaled.fields.at("ior_grad").data[i], static_cast<float>(grad.data[i] / s[i % 3]));
+  const glm::dvec3 along = glm::normalize(s * glm::dvec3(0.6, 0.0, -0.8));
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(scaled.fields.at("light_dir").data[c], along[c], 1e-6);
+  const std::vector<float>& d0 = volume.fields.at("interfaces").data;
+  for (std::size_t i = 0; i < d0.size(); i += 37)
+    EXPECT_FLOAT_EQ(scaled.fields.at("interfaces").data[i], static_cast<float>(0.75 * d0[i]));
+  EXPECT_EQ(scaled.fields.at("ior").data, volume.fields.at("ior").data);
+  ASSERT_EQ(scaled.receivers.size(), 1u);
+  const ReceiverMap& m = scaled.receivers[0];
+  // Texel centres land where S takes them.
+  EXPECT_NEAR(glm::length(m.texelCenter(0, 0) - s * map.texelCenter(0, 0)), 0.0, 1e-12);
+  EXPECT_NEAR(m.pitch, 1.5 * 0.05, 1e-15);
+  EXPECT_NEAR(glm::length(m.normal - map.normal), 0.0, 1e-12);
+  EXPECT_EQ(m.irradiance, map.irradiance);
+  const nlohmann::json& light = scaled.metadata.at("light");
+  EXPECT_NEAR(light["position"][1].get<double>(), 1.5, 1e-12);
+  EXPECT_NEAR(light["position"][2].get<double>(), 4.5, 1e-12);
+  const glm::dvec3 axis = glm::normalize(s * glm::dvec3(0.0, -0.6, 0.8));
+  EXPECT_NEAR(light["direction"][1].get<double>(), axis.y, 1e-12);
+  EXPECT_TRUE(scaled.field_files.empty());  // nothing copied from files the data no longer matches
+
+  dropped.clear();
+  EXPECT_TRUE(volumeAtWorldScale(volume, glm::dvec3(1.5, 0.75, 1.2), &dropped).receivers.empty());
+  EXPECT_EQ(dropped, std::vector<std::string>{"ground"});
+
+  // A scene object scaled so is taken in with scale 1; a uniform one is left alone; the bake frame
+  // refuses an object still scaled unevenly.
+  SceneObjectSpec object;
+  object.scale = s;
+  EXPECT_THROW(BakeFrame::of(object), std::invalid_argument);
+  Volume taken = volume;
+  EXPECT_TRUE(takeInAxisScale(taken, object));
+  EXPECT_EQ(object.scale, glm::dvec3(1.0));
+  EXPECT_EQ(taken.grid, scaled.grid);
+  object.scale = glm::dvec3(2.0);
+  EXPECT_FALSE(takeInAxisScale(taken, object));
+  EXPECT_EQ(taken.grid, scaled.grid);
+}
+
 // The issue's check of a placed object: the logo block (1 × 1 × 0.5, a dark blue logo of another
 // glass inside) turned 30° about the vertical and scaled 1.5, standing over the floor y = 0 in an
 // oblique sun, baked as `lightsim SCENE.json` bakes a scene's object (its own volume, the light and
@@ -127,8 +196,11 @@ double relativeL2InCells(const ReceiverMap& map, const ReceiverMap& reference, i
   return std::sqrt(diff / norm);
 }
 
-PlacedBlockBakes bakeTheTurnedBlockBothWays(int res, bool unturned_too) {
-  constexpr double kScale = 1.5, kTurnDeg = 30.0;
+// `shape` (a procedural shape of unit width, voxelized with res voxels across) turned `turn_deg`
+// about the vertical and scaled by `scale` along its axes, centred at (0, 1, 0): within `reach` of
+// its centre once placed.
+PlacedBlockBakes bakePlacedBothWays(const std::string& shape, const glm::dvec3& scale, double turn_deg, double reach,
+                                    int res, bool unturned_too) {
   const glm::dvec3 centre(0.0, 1.0, 0.0);
   LightSpec sun;
   sun.direction = glm::normalize(glm::dvec3(0.3, -1.0, -0.5));
@@ -145,33 +217,38 @@ PlacedBlockBakes bakeTheTurnedBlockBothWays(int res, bool unturned_too) {
     options.volume_deposits = false;
     return options;
   };
-  // In place: voxels of edge kScale / res in a cube around the turned block (half-diagonal in x
-  // 0.75·cos 30° + 0.375·sin 30° = 0.84) with three voxels of air.
-  const double h = kScale / res;
-  const int half_voxels = static_cast<int>(std::ceil(0.84 / h)) + 3;
+  // In place: cubic voxels as short as the scene object's shortest (min(s) / res) in a cube around
+  // the placed shape with three voxels of air.
+  const double h = std::min(scale.x, std::min(scale.y, scale.z)) / res;
+  const int half_voxels = static_cast<int>(std::ceil(reach / h)) + 3;
   Bounds cube;
   cube.extend(centre - glm::dvec3(half_voxels * h));
   cube.extend(centre + glm::dvec3(half_voxels * h));
-  char spec[160];
-  std::snprintf(spec, sizeof spec, "procedural:logo_block,center=0:%g:0,scale=%g,euler_deg=0:%g:0", centre.y, kScale,
-                kTurnDeg);
+  char spec[200];
+  std::snprintf(spec, sizeof spec, "procedural:%s,center=0:%g:0,scale=%.17g:%.17g:%.17g,euler_deg=0:%g:0", shape.c_str(),
+                centre.y, scale.x, scale.y, scale.z, turn_deg);
   const Volume in_place = test_scenes::sharpVolume(spec, 2 * half_voxels, cube);
   EXPECT_NEAR(voxelEdge(in_place.grid), h, 1e-12);
   SimulationOptions options = optionsFor(in_place.grid);
   options.receiver = floor;
   const ReceiverMap reference = CpuSimulator(in_place).run(sun, options).receivers.at(0);
 
-  // The scene's object: the block voxelized unturned at its own size, res voxels across its width.
-  const Volume block = test_scenes::sharpVolume("procedural:logo_block", res);
-  EXPECT_NEAR(voxelEdge(block.grid) * kScale, h, 1e-12);
-  const auto sceneBake = [&](double turn_deg) {
+  // The scene's object: the shape voxelized unturned at its own size, res voxels across its width,
+  // taken in as a scene takes it (scaled unevenly: the volume at world scale along each axis).
+  const Volume shape_volume = test_scenes::sharpVolume("procedural:" + shape, res);
+  EXPECT_NEAR(voxelEdge(shape_volume.grid), 1.0 / res, 1e-12);
+  const auto sceneBake = [&](double turn) {
     SceneObjectSpec object;
     object.translate = centre;
-    object.rotate_deg = {0.0, turn_deg, 0.0};
-    object.scale = kScale;
+    object.rotate_deg = {0.0, turn, 0.0};
+    object.scale = scale;
+    Volume volume = shape_volume;
+    const bool uneven = !object.uniformScale();
+    EXPECT_EQ(takeInAxisScale(volume, object), uneven);
+    EXPECT_TRUE(object.uniformScale());
     const BakeFrame frame = BakeFrame::of(object);
-    const Volume at_scale = volumeAtWorldScale(block, frame.scale);
-    SimulationOptions placed = optionsFor(block.grid);
+    const Volume at_scale = volumeAtWorldScale(volume, frame.scale);
+    SimulationOptions placed = optionsFor(at_scale.grid);
     placed.receiver = frame.receiver(floor);
     ReceiverMap lattice = reference;  // the in-place map's texels, in the bake frame
     const glm::dmat3 to_bake = glm::transpose(frame.rotation);
@@ -183,17 +260,22 @@ PlacedBlockBakes bakeTheTurnedBlockBothWays(int res, bool unturned_too) {
     return CpuSimulator(at_scale).run(frame.light(sun), placed).receivers.at(0);
   };
   const int bin = static_cast<int>(std::lround(kCell / reference.pitch));
-  const ReceiverMap turned = sceneBake(kTurnDeg);
+  const ReceiverMap turned = sceneBake(turn_deg);
   PlacedBlockBakes out;
   out.texels = relativeL2InCells(turned, reference, 1);
   out.cells = relativeL2InCells(turned, reference, bin);
   if (unturned_too) out.unturned_cells = relativeL2InCells(sceneBake(0.0), reference, bin);
-  std::printf("%d³ (in place %d³, %d × %d texels): the placed block's floor against the block voxelized in place: "
-              "%.2f %% relative L2 texel for texel, %.2f %% in cells of %d × %d texels (%.2f %% with the turn left "
-              "out)\n",
-              res, 2 * half_voxels, reference.texels.x, reference.texels.y, 100.0 * out.texels, 100.0 * out.cells, bin,
-              bin, 100.0 * out.unturned_cells);
+  std::printf("%s scaled %g:%g:%g, %d³ (in place %d³, %d × %d texels): the placed shape's floor against the shape "
+              "voxelized in place: %.2f %% relative L2 texel for texel, %.2f %% in cells of %d × %d texels (%.2f %% "
+              "with the turn left out)\n",
+              shape.c_str(), scale.x, scale.y, scale.z, res, 2 * half_voxels, reference.texels.x, reference.texels.y,
+              100.0 * out.texels, 100.0 * out.cells, bin, bin, 100.0 * out.unturned_cells);
   return out;
+}
+
+// The logo block turned 30° and scaled 1.5: its half-diagonal in x 0.75·cos 30° + 0.375·sin 30° = 0.84.
+PlacedBlockBakes bakeTheTurnedBlockBothWays(int res, bool unturned_too) {
+  return bakePlacedBothWays("logo_block", glm::dvec3(1.5), 30.0, 0.84, res, unturned_too);
 }
 
 TEST(PlacedObject, TheTurnedAndScaledBlockBakesAsTheBlockVoxelizedInPlace) {
@@ -206,6 +288,27 @@ TEST(PlacedObject, TheTurnedAndScaledBlockBakesAsTheBlockVoxelizedInPlace) {
   EXPECT_LT(fine.cells, coarse.cells);
   EXPECT_LT(fine.texels, coarse.texels);
   // The check can fail: the block left unturned throws another shadow (measured 30 %).
+  EXPECT_GT(fine.unturned_cells, 10.0 * fine.cells);
+}
+
+// The same check with a scale that differs along the object's axes (the issue's "non-uniform
+// scale"): the unit glass sphere scaled 1.5 : 0.75 : 1.2 (an ellipsoid) and turned 30° about the
+// vertical, baked as a scene takes it in (its volume on voxels 1.5 : 0.75 : 1.2 as long as they
+// were, distances × 0.75), against the ellipsoid voxelized in place on cubic voxels as short as
+// the shortest of those.
+TEST(PlacedObject, TheUnevenlyScaledSphereBakesAsTheEllipsoidVoxelizedInPlace) {
+  const glm::dvec3 scale(1.5, 0.75, 1.2);
+  const PlacedBlockBakes coarse = bakePlacedBothWays("sphere", scale, 30.0, 0.75, 32, false);
+  const PlacedBlockBakes fine = bakePlacedBothWays("sphere", scale, 30.0, 0.75, 48, true);
+  // The issue's 1 % in quarter-unit cells: measured 0.19 % at 32³ and 0.23 % at 48³, both at the
+  // floor of what two voxelizations of a smooth surface share there (no faces cut obliquely, no
+  // strokes of one voxel, as the block has), so only their bound is asserted; texel for texel
+  // (0.25 voxel) 4.06 % and 3.39 %, falling with resolution.
+  EXPECT_LT(coarse.cells, 0.01);
+  EXPECT_LT(fine.cells, 0.01);
+  EXPECT_LT(fine.texels, coarse.texels);
+  // The check can fail: the ellipsoid left unturned lies along other axes (measured 14 %), and
+  // taken in with one mean scale (cbrt(1.5 · 0.75 · 1.2)) instead of its three, 32 %.
   EXPECT_GT(fine.unturned_cells, 10.0 * fine.cells);
 }
 

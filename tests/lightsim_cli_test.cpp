@@ -292,6 +292,25 @@ TEST(LightsimCli, BakesAWholeSceneIntoAFolderTheViewerOpens) {
   EXPECT_NEAR(glm::dot(map.point, map.normal), -0.75, 1e-9);
   ProgramResult v = runProgram(VIEWER_EXE, {"baked/SCENE.json", "--render", "scene.png", "--size", "48x32"}, dir.path());
   EXPECT_EQ(v.exit_code, 0) << v.output;
+  // Scaled differently along its axes: baked and written as the volume at world scale along each
+  // axis (its box × (1.2, 0.6, 1)), placed with scale 1 in the baked SCENE.json; its map lies on
+  // the ground y = −0.6 in world units.
+  writeFile(dir / "uneven.json", R"({
+    "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": [2, 2, 2]}],
+    "ground": {"point": [0, -0.6, 0], "normal": [0, 1, 0], "half_extent": 2},
+    "objects": [{"volume": "sharp.vol.json", "rotate_deg": [0, 30, 0], "scale": [1.2, 0.6, 1]}]})");
+  r = runProgram(LIGHTSIM_EXE, {"uneven.json", "-o", "uneven", "--quiet"}, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json uneven = nlohmann::json::parse(readFile(dir / "uneven" / "SCENE.json"));
+  EXPECT_EQ(uneven["objects"][0]["scale"], 1.0);
+  EXPECT_EQ(uneven["objects"][0]["rotate_deg"][1], 30.0);
+  const Volume stretched = readVolume(dir / "uneven" / "sharp.baked.vol.json");
+  const Volume input = readVolume(dir / "sharp.vol.json");
+  EXPECT_NEAR(glm::length(stretched.grid.bounds_max - glm::dvec3(1.2, 0.6, 1.0) * input.grid.bounds_max), 0.0, 1e-9);
+  ASSERT_EQ(stretched.receivers.size(), 1u);
+  EXPECT_NEAR(glm::dot(stretched.receivers[0].point, stretched.receivers[0].normal), -0.6, 1e-9);
+  v = runProgram(VIEWER_EXE, {"uneven/SCENE.json", "--render", "uneven.png", "--size", "48x32"}, dir.path());
+  EXPECT_EQ(v.exit_code, 0) << v.output;
   // A scene input takes no light, receiver, stats or bench of its own, -o names a folder, and a
   // missing object's volume stops the bake before anything is written.
   writeFile(dir / "missing.json", R"({"lights": [{"type": "directional", "direction": [0, -1, 0]}],

@@ -108,7 +108,7 @@ TEST(BackgroundBake, AScaledObjectIsRebakedAtWorldScale) {
   slab.receivers.push_back(ReceiverMap{});  // as a baked volume has: the window re-bakes it
   Scene scene;
   SceneObjectSpec placed;
-  placed.scale = 2.0;
+  placed.scale = glm::dvec3(2.0);
   placed.translate = {0.3, 0.0, -0.2};
   scene.objects.push_back(placed);
   SceneGroundSpec ground;

@@ -1,17 +1,28 @@
 #include "viewer/loaded_scene.h"
 
 #include <cmath>
+#include <cstdio>
 #include <utility>
 
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/error.h"
+#include "lightsim/scene_bake.h"
 
 namespace eik {
 namespace {
 
 bool endsWith(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// A receiver map a volume was baked with that cannot follow the scene's uneven scale (its plane
+// would need a rectangular lattice): the ground under that object shows the direct light only.
+void warnMapLeftOut(const std::string& source, const std::string& map) {
+  std::fprintf(stderr,
+               "viewer: %s: its receiver map '%s' cannot follow a scale that differs along its plane: left out "
+               "(bake the scene with lightsim SCENE.json to light the ground)\n",
+               source.c_str(), map.c_str());
 }
 
 // The viewer needs n and ∇n (Eq. 5.11/5.12); every other field is optional.
@@ -103,6 +114,7 @@ LoadedScene sceneFromVolumes(Scene scene, std::vector<Volume> volumes) {
     object.source = scene.objects[i].volume.empty() ? "objects[" + std::to_string(i) + "]" : scene.objects[i].volume;
     requireOptics(volumes[i], object.source);
     object.volume = std::move(volumes[i]);
+    takeInAxisScale(object.volume, scene.objects[i], [&](const std::string& map) { warnMapLeftOut(object.source, map); });
     object.object_to_world = objectToWorld(scene.objects[i]);
     loaded.objects.push_back(std::move(object));
   }
@@ -123,14 +135,15 @@ LoadedScene loadScene(const std::filesystem::path& input) {
     environment.file = std::filesystem::absolute(loaded.scene.resolve("environment.file", environment.file)).string();
   if (loaded.scene.objects.empty()) throw InputError(text, "objects", "the scene has no object");
   for (std::size_t i = 0; i < loaded.scene.objects.size(); ++i) {
-    const SceneObjectSpec& spec = loaded.scene.objects[i];
-    if (!(spec.scale > 0) || !std::isfinite(spec.scale))
-      throw InputError(text, "objects[" + std::to_string(i) + "].scale", "must be a positive number");
+    SceneObjectSpec& spec = loaded.scene.objects[i];
     LoadedObject object;
     object.source =
         std::filesystem::absolute(loaded.scene.resolve("objects[" + std::to_string(i) + "].volume", spec.volume)).string();
     object.volume = readVolume(object.source);
     requireOptics(object.volume, object.source);
+    // Scaled differently along its axes: the volume at world scale along each axis, placed with
+    // scale 1, as lightsim bakes it (lightsim/scene_bake.h).
+    takeInAxisScale(object.volume, spec, [&](const std::string& map) { warnMapLeftOut(object.source, map); });
     object.object_to_world = objectToWorld(spec);
     loaded.objects.push_back(std::move(object));
   }

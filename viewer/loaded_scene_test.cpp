@@ -27,7 +27,7 @@ TEST(LoadedScene, PlacementIsTranslateRotateScale) {
   SceneObjectSpec o;
   o.translate = glm::dvec3(1, 2, 3);
   o.rotate_deg = glm::dvec3(0, 90, 0);
-  o.scale = 2;
+  o.scale = glm::dvec3(2.0);
   const glm::dvec4 p = objectToWorld(o) * glm::dvec4(1, 0, 0, 1);
   // x → scaled to 2 → turned 90° about y to −z → moved.
   EXPECT_NEAR(p.x, 1, 1e-12);

@@ -40,22 +40,29 @@ std::string regionName(const ShapeParams& p, const std::string& fallback, const 
   return p.given("name") ? m.name : fallback;
 }
 
-// The keys every shape but the floor takes after its own: a uniform scale and a turn about the
-// shape's centre, as a scene places a volume (docs/scene-format.md: X, then Y, then Z).
+// The keys every shape but the floor takes after its own: a scale (one number, or X:Y:Z along the
+// shape's axes) and a turn about the shape's centre, as a scene places a volume
+// (docs/scene-format.md: X, then Y, then Z).
 std::vector<ParamDef> placed(std::vector<ParamDef> params) {
-  params.push_back(positiveParam("scale", "1", "scale about the centre (σa stays per world unit, as a scene's scale)"));
+  params.push_back(tripleParam("scale", "1", 0.0, true,
+                               "scale about the centre, one number or X:Y:Z along the shape's axes (σa stays per "
+                               "world unit, as a scene's scale)"));
   params.push_back(tripleParam("euler_deg", "0:0:0", -1e300, false,
                                "turn about the centre: degrees about X, then Y, then Z (a scene's rotate_deg)"));
   return params;
 }
 
-// The solids scaled by s and turned by R about c: x = c + R·s·(x_shape − c). A signed distance
-// scales by s and keeps under a turn; the bounds are those of the turned box's corners.
-void place(std::vector<ImplicitSolid>& solids, const dvec3& c, double s, const dvec3& euler_deg) {
-  if (s == 1.0 && euler_deg == dvec3(0.0)) return;
+// The solids scaled by S = diag(s) and turned by R about c: x = c + R·S·(x_shape − c). A signed
+// distance keeps under a turn and scales by s under a uniform scale; under an uneven one it is no
+// distance any more, and × min(s) keeps its zero set (the surface) exact and every value a lower
+// bound of the distance (as lightsim/scene_bake.h volumeAtWorldScale does to a volume's). The
+// bounds are those of the turned box's corners.
+void place(std::vector<ImplicitSolid>& solids, const dvec3& c, const dvec3& scale, const dvec3& euler_deg) {
+  if (scale == dvec3(1.0) && euler_deg == dvec3(0.0)) return;
+  const double s = std::min(scale.x, std::min(scale.y, scale.z));
   SceneObjectSpec placement;
   placement.rotate_deg = euler_deg;
-  placement.scale = s;
+  placement.scale = scale;
   const glm::dmat3 to_world(objectToWorld(placement));
   const glm::dmat3 to_shape = glm::inverse(to_world);
   for (ImplicitSolid& solid : solids) {
@@ -426,7 +433,7 @@ std::vector<ImplicitSolid> buildShapeSolids(const ProceduralSpec& spec, double v
   const ShapeDef& shape = findShape(spec.name, kProceduralPrefix + spec.name);
   const ShapeParams params(shape.name, shape.params, shape.material_keys, spec);
   std::vector<ImplicitSolid> solids = shape.build(params, voxel_height);
-  if (params.has("scale")) place(solids, params.vec("center"), params.number("scale"), params.vec("euler_deg"));
+  if (params.has("scale")) place(solids, params.vec("center"), params.vec("scale"), params.vec("euler_deg"));
   return solids;
 }
 

@@ -95,6 +95,34 @@ TEST(ProceduralShapes, ScaleAndEulerAnglesPlaceTheShapeAboutItsCentre) {
   EXPECT_NE(specErrorOf("procedural:box,scale=0").find("scale"), std::string::npos);
   EXPECT_NE(specErrorOf("procedural:box,euler_deg=1:x:2").find("euler_deg"), std::string::npos);
   EXPECT_NE(specErrorOf("procedural:floor,scale=2").find("unknown key"), std::string::npos);  // a floor is a plane
+  EXPECT_NE(specErrorOf("procedural:box,scale=1:0:1").find("scale"), std::string::npos);
+}
+
+// scale=X:Y:Z scales along the shape's own axes before the turn: the unit sphere (r 0.5) scaled
+// 1.5 : 0.75 : 1.2 and turned 90° about y is the ellipsoid with semi-axes 0.75 along world z (its
+// x), 0.375 along y and 0.6 along world x (its z). The distance is the sphere's × 0.75 (the
+// shortest factor): exact along the shortest axis, a lower bound elsewhere, zero on the surface.
+TEST(ProceduralShapes, AScaleAlongTheAxesMakesTheSphereAnEllipsoid) {
+  const ProceduralSpec spec{"sphere", {{"scale", "1.5:0.75:1.2"}, {"euler_deg", "0:90:0"}}};
+  const auto solids = buildShapeSolids(spec, 0.01);
+  ASSERT_EQ(solids.size(), 1u);
+  const auto& sdf = solids[0].sdf;
+  EXPECT_NEAR(sdf(glm::dvec3(0.0, 0.0, 0.75)), 0.0, 1e-12);
+  EXPECT_NEAR(sdf(glm::dvec3(0.0, 0.0, -0.75)), 0.0, 1e-12);
+  EXPECT_NEAR(sdf(glm::dvec3(0.6, 0.0, 0.0)), 0.0, 1e-12);
+  EXPECT_NEAR(sdf(glm::dvec3(0.0, 0.375, 0.0)), 0.0, 1e-12);
+  EXPECT_NEAR(sdf(glm::dvec3(0.0, 0.475, 0.0)), 0.1, 1e-12);  // along the shortest axis: exact
+  EXPECT_LT(sdf(glm::dvec3(0.0, 0.0, 0.85)), 0.1);            // along the longest: a lower bound
+  EXPECT_GT(sdf(glm::dvec3(0.0, 0.0, 0.85)), 0.0);
+  EXPECT_LT(sdf(glm::dvec3(0.59, 0.0, 0.0)), 0.0);
+  EXPECT_NEAR(solids[0].bounds.max.z, 0.75, 1e-12);
+  EXPECT_NEAR(solids[0].bounds.max.x, 0.6, 1e-12);
+  EXPECT_NEAR(solids[0].bounds.max.y, 0.375, 1e-12);
+  // Voxelised: the enclosed volume is the ellipsoid's, 4/3·π·0.75·0.375·0.6 (within the
+  // occupancy's supersampling error on 64³, as above).
+  const GridSpec grid = makeGrid(proceduralBounds(spec), 64, 3.0);
+  const auto regions = voxelizeProcedural(spec, grid);
+  EXPECT_NEAR(regions.at(0).enclosed_volume / (4.0 / 3.0 * 3.14159265358979 * 0.75 * 0.375 * 0.6), 1.0, 0.01);
 }
 
 TEST(Procedural, EveryShapeVoxelises) {
