@@ -413,8 +413,10 @@ SimulationOptions softShadowOptions(const Volume& volume, double half_extent) {
   return options;
 }
 
-ReceiverMap bakeSphereUnderTheSunsDisc(int res, double angular_diameter_deg) {
-  const Volume volume = sharpVolume("procedural:sphere,r=1,center=0:1.5:0,ior=1.5", res, std::nullopt, 2.0);
+ReceiverMap bakeSphereUnderTheSunsDisc(int res, double angular_diameter_deg, double height = 1.5) {
+  char spec[96];
+  std::snprintf(spec, sizeof spec, "procedural:sphere,r=1,center=0:%g:0,ior=1.5", height);
+  const Volume volume = sharpVolume(spec, res, std::nullopt, 2.0);
   CpuSimulator sim(volume);
   SimulationOptions options = softShadowOptions(volume, 1.6);
   const ReceiverSpec floor = *options.receiver;
@@ -453,6 +455,39 @@ TEST(ExactOpticsSoftSun, TheSunsDiscCastsThePenumbraOfGeometry) {
   // Centred on the sharp shadow's edge (r = 1: the disc is symmetric), within a texel (0.0056).
   EXPECT_NEAR(soft.centre, hard.centre, 0.006);
   // Without the disc the edge is a texel or two wide: the penumbra is the disc's.
+  EXPECT_LT(hard.width, 0.3 * geometric);
+}
+
+// The sun's own 0.53°: the same penumbra, 12 times narrower, made wide enough to measure by
+// standing the sphere high over the floor (its equator L = 18.5 up): 2·x₈₀·α·L = 0.084, 15
+// texels at 48³ (measured 0.0843 at 32³ and 0.0841 at 48³). The light the sphere focuses 1.5 below its centre has spread over 11 times its width by
+// the floor (a smooth percent of the sun there), and the penumbra itself reaches α·L = 0.086 to
+// either side of the edge, so the shadow's and the light's levels are taken further out
+// (r 0.80–0.85 and 1.15–1.20).
+TEST(ExactOpticsSoftSun, TheRealSunsHalfDegreeCastsThePenumbraOfGeometry) {
+  constexpr double kTheta = 0.53, kHeight = 18.5;
+  double x80 = 0.0;  // f(x) = 0.8 by bisection
+  for (double a = 0.0, b = 1.0; b - a > 1e-12; x80 = 0.5 * (a + b)) {
+    const double m = 0.5 * (a + b);
+    (0.5 + (m * std::sqrt(1.0 - m * m) + std::asin(m)) / std::numbers::pi < 0.8 ? a : b) = m;
+  }
+  const double geometric = 2.0 * x80 * glm::radians(0.5 * kTheta) * kHeight;
+  PenumbraWindow window;
+  window.from = 0.78;
+  window.inside_lo = 0.80;
+  window.inside_hi = 0.85;
+  window.outside_lo = 1.15;
+  window.outside_hi = 1.20;
+  const Penumbra coarse = penumbraOf(bakeSphereUnderTheSunsDisc(32, kTheta, kHeight), window);
+  const Penumbra soft = penumbraOf(bakeSphereUnderTheSunsDisc(48, kTheta, kHeight), window);
+  const Penumbra hard = penumbraOf(bakeSphereUnderTheSunsDisc(48, 0.0, kHeight), window);
+  std::printf("the sun's 0.53°: penumbra 20-80 %%: %.4f at 32³, %.4f at 48³ (geometric %.4f), its middle at r = %.4f; "
+              "the point-like sun's edge %.4f wide\n",
+              coarse.width, soft.width, geometric, soft.centre, hard.width);
+  // The bound: within 10 % of the geometric width, at both resolutions.
+  EXPECT_NEAR(coarse.width / geometric, 1.0, 0.10);
+  EXPECT_NEAR(soft.width / geometric, 1.0, 0.10);
+  EXPECT_NEAR(soft.centre, hard.centre, 0.006);
   EXPECT_LT(hard.width, 0.3 * geometric);
 }
 
