@@ -91,9 +91,11 @@ VolumeTextureLayout VolumeTextureLayout::plan(const std::vector<std::pair<std::s
   return layout;
 }
 
-VolumeTextureLayout VolumeTextureLayout::plan(const Volume& volume, bool padToRGBA) {
+VolumeTextureLayout VolumeTextureLayout::plan(const Volume& volume, bool padToRGBA,
+                                              const std::vector<std::string>& leave_out) {
   std::vector<std::pair<std::string, int>> fields;
-  for (const auto& [name, field] : volume.fields) fields.emplace_back(name, field.components);
+  for (const auto& [name, field] : volume.fields)
+    if (std::find(leave_out.begin(), leave_out.end(), name) == leave_out.end()) fields.emplace_back(name, field.components);
   return plan(fields, padToRGBA);
 }
 
@@ -134,7 +136,7 @@ std::size_t defaultTextureBudget() {
 }
 
 VolumeTextures::VolumeTextures(const Volume& volume, const VolumeTextureOptions& options)
-    : layout_(VolumeTextureLayout::plan(volume, options.padToRGBA)), dims_(volume.grid.dims) {
+    : layout_(VolumeTextureLayout::plan(volume, options.padToRGBA, options.leave_out)), dims_(volume.grid.dims) {
   const GlContext& context = detail::requireContext("uploading a volume");
   const int limit = context.info().max3DTextureSize;
   if (dims_.x < 1 || dims_.y < 1 || dims_.z < 1) {

@@ -52,7 +52,8 @@ class VolumeTextureLayout {
   // The grouping above applied to the fields present (name, components); RuntimeError when a
   // known field has the wrong number of components.
   static VolumeTextureLayout plan(const std::vector<std::pair<std::string, int>>& fields, bool padToRGBA = false);
-  static VolumeTextureLayout plan(const Volume& volume, bool padToRGBA = false);
+  static VolumeTextureLayout plan(const Volume& volume, bool padToRGBA = false,
+                                  const std::vector<std::string>& leave_out = {});
 
   const std::vector<VolumeTextureSlot>& textures() const { return textures_; }
   int textureCount() const { return static_cast<int>(textures_.size()); }
@@ -84,6 +85,9 @@ struct VolumeTextureOptions {
   // Texture memory the volume may take; 0 = defaultTextureBudget().
   std::size_t budgetBytes = 0;
   std::string source = "volume";  // for error messages: the manifest path
+  // Fields not uploaded (and not in the layout): what a shader takes elsewhere, e.g. the viewer's
+  // σa where every material has one constant (MEDIUM_SIGMA_A).
+  std::vector<std::string> leave_out;
 };
 
 // EIKONAL_GL_TEXTURE_BUDGET_MB, else 4096 MiB.

@@ -78,6 +78,24 @@ TEST(VolumeTextureLayoutTest, BakedVolumeAndPadding) {
   EXPECT_EQ(VolumeTextureLayout::plan(Fields{}).glslDefines(), "#define VOLUME_TEXTURE_COUNT 0\n");
 }
 
+// A field left out (VolumeTextureOptions::leave_out: what the shader takes elsewhere) is not in the
+// layout: its group goes when nothing else is in it, and no HAS_ define names it.
+TEST(VolumeTextureLayoutTest, AFieldLeftOutIsNotUploaded) {
+  Volume volume;
+  volume.grid.dims = {2, 2, 2};
+  volume.addField("ior", 1);
+  volume.addField("ior_grad", 3);
+  volume.addField("sigma_a", 3);
+  EXPECT_EQ(VolumeTextureLayout::plan(volume, true).textureCount(), 2);
+  const VolumeTextureLayout without = VolumeTextureLayout::plan(volume, true, {"sigma_a"});
+  EXPECT_EQ(without.textureCount(), 1);
+  EXPECT_EQ(without.find("sigma_a"), nullptr);
+  EXPECT_EQ(without.glslDefines().find("SIGMA_A"), std::string::npos);
+  volume.addField("dispersion", 1);  // shares the absorption texture, which stays for it
+  EXPECT_EQ(describe(VolumeTextureLayout::plan(volume, false, {"sigma_a"})),
+            "optics[4]: ior.r ior_grad.gba; absorption[1]: dispersion.r; ");
+}
+
 TEST(VolumeTextureLayoutTest, WrongComponentCountIsAnError) {
   EXPECT_THROW(VolumeTextureLayout::plan(Fields{{"ior_grad", 4}}), RuntimeError);
 }

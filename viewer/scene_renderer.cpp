@@ -194,13 +194,21 @@ struct SceneRenderer::Impl {
     gl::VolumeTextureOptions options;
     options.source = loaded.source;
     options.padToRGBA = true;  // llvmpipe samples RGBA32F faster than RGB32F (σa: about 10 % a frame)
+    const InterfaceTable table = interfaceTable(loaded.volume, loaded.source);
+    const SlotMedia media = slotMedia(loaded.volume, table);
+    o.defines = interfaceDefines(table) + slotMediumDefines(media);
+    // σa one constant in every material: the shader takes it from MEDIUM_SIGMA_A and never samples
+    // the field, so it is not uploaded (unless dispersion shares its texture): a texture unit and
+    // its memory saved an absorbing object (nine objects in one shader, the thesis' Fig. 7.5a).
+    if (loaded.volume.has("sigma_a") && media.sigma_a_constant) {
+      o.defines += "#define SIGMA_A_BY_MATERIAL 1\n";
+      if (!loaded.volume.has("dispersion")) options.leave_out.push_back("sigma_a");
+    }
     o.textures = gl::VolumeTextures(loaded.volume, options);
     const gl::VolumeFieldSlot* ior = o.textures.layout().find("ior");
     const gl::VolumeFieldSlot* grad = o.textures.layout().find("ior_grad");
     if (!ior || !grad || ior->texture != grad->texture || ior->channel != 0 || grad->channel != 1)
       throw RuntimeError("viewer: expected ior and ior_grad together in one RGBA texture");
-    const InterfaceTable table = interfaceTable(loaded.volume, loaded.source);
-    o.defines = interfaceDefines(table) + slotMediumDefines(slotMedia(loaded.volume, table));
     if (scene.ground) attachReceiver(o, loaded, *scene.ground, prepared_texels);
     if (o.has_receiver) o.defines += "#define HAS_RECEIVER 1\n";
     const std::vector<float> bricks = homogeneousBricks(loaded.volume, o.brick_dims);
@@ -317,9 +325,11 @@ struct SceneRenderer::Impl {
       p.setSampler(objectBricksSampler(k), unit);
       ++unit;
       if (o.has_receiver) {
-        o.receiver_texture.bind(unit);
-        p.setSampler(objectReceiverSampler(k), unit);
-        ++unit;
+        if (!has_ground_map) {  // else the ground map holds its change (groundRadiance)
+          o.receiver_texture.bind(unit);
+          p.setSampler(objectReceiverSampler(k), unit);
+          ++unit;
+        }
         p.set("uObjRecvPoint" + i, glm::vec3(o.receiver.point));
         p.set("uObjRecvU" + i, glm::vec3(o.receiver.u));
         p.set("uObjRecvV" + i, glm::vec3(o.receiver.v));
@@ -409,11 +419,15 @@ SceneRenderer::SceneRenderer(const gl::ShaderLibrary& shaders, const LoadedScene
     const std::vector<float>* texels = nullptr;
     if (prepared && i < prepared->ground_texels.size() && prepared->ground_texels[i]) texels = &*prepared->ground_texels[i];
     Impl::Object o = s.makeObject(scene.objects[i], texels);
-    units += o.textures.layout().textureCount() + 1 + (o.has_receiver ? 1 : 0);
+    units += o.textures.layout().textureCount() + 1;
     s.objects.push_back(std::move(o));
   }
+  // Two receiver maps or more are summed into the ground map, one texture, and the shader samples
+  // no object's own (groundRadiance): nine baked spheres (the thesis' Fig. 7.5a) fit in 32 units.
   s.buildGroundMap();
   if (s.has_ground_map) ++units;
+  else
+    for (const Impl::Object& o : s.objects) units += o.has_receiver ? 1 : 0;
   if (units > max_units)
     throw InputError(scene.source, "objects",
                      "the objects' volumes need " + std::to_string(units) + " textures, more than the " +

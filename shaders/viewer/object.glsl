@@ -373,7 +373,7 @@ bool skipHomogeneousBrick@(inout March@ m, vec3 uvw) {
     toFace = mix(vec3(1e30), toFace, greaterThan(abs(dir), vec3(1e-8)));
     float L = min(min(toFace.x, toFace.y), toFace.z) + 0.01 * m.h;
     if (!m.inLayer) rememberStateBeforeLayer@(m, length(m.w), dir);  // a quiet stretch
-#if defined(ATTENUATION) && defined(HAS_SIGMA_A) && defined(MEDIUM_SIGMA_A)
+#if defined(ATTENUATION) && defined(SIGMA_A_BY_MATERIAL)
     m.tau += MEDIUM_SIGMA_A(m.medium) * (L * uObjLengthScale[@]);  // Beer–Lambert, σa constant here
 #elif defined(ATTENUATION) && defined(HAS_SIGMA_A)
     m.tau += volumeSigmaA(uvw) * (L * uObjLengthScale[@]);
@@ -439,7 +439,7 @@ void followBoundaryLayer@(inout Ray r, inout March@ m, vec3 grad, float grad2, b
 // material the ray is in where every material has one (MEDIUM_SIGMA_A, volume_analysis.h
 // slotMedia), else fetched, only inside the box where it is not 0 (absorbingRegion).
 void absorb@(inout March@ m, vec3 uvw, float hs) {
-#if defined(ATTENUATION) && defined(HAS_SIGMA_A) && defined(MEDIUM_SIGMA_A)
+#if defined(ATTENUATION) && defined(SIGMA_A_BY_MATERIAL)
   m.tau += MEDIUM_SIGMA_A(m.medium) * hs;  // constant in the material the ray is in: no fetch
 #elif defined(ATTENUATION) && defined(HAS_SIGMA_A)
   vec3 x = m.bmin + uvw * (uObjBoundsMax[@] - m.bmin);  // uvw's point (the step's middle)
@@ -467,7 +467,7 @@ void inScatter@(inout Ray r, March@ m, vec3 uvw, float hs) {
   if (scatter.x > 0.0) {
     vec3 l = volumeLightDir(uvw);
     float cosTheta = dot(l, -normalize(m.w));
-#if defined(ATTENUATION) && defined(HAS_SIGMA_A) && defined(MEDIUM_SIGMA_A)
+#if defined(ATTENUATION) && defined(SIGMA_A_BY_MATERIAL)
     // σa is constant over the step (absorb@ has added its x = σa·hs to τ): the light scattered at
     // s within it is attenuated by exp(−τ + x − σa·s), and ∫₀^hs of that is exp(−τ)·(eˣ − 1)/σa.
     vec3 x = MEDIUM_SIGMA_A(m.medium) * hs;
