@@ -4,6 +4,7 @@
 //          [--camera EX,EY,EZ:TX,TY,TZ:FOVY_DEG] [--env FILE | uniform:R,G,B | checker[:R,G,B] | sky]
 //          [--step VOXELS] [--integrator euler|rk4] [--no-refraction] [--no-fresnel] [--no-scattering]
 //          [--no-attenuation] [--no-emission] [--no-dispersion] [--no-ground] [--no-skip]
+//          [--no-reflect-objects]
 //
 //   viewer SCENE.json | VOLUME.vol.json            (no --render: the interactive window, viewer/window.h)
 //          [--window-frames N --save OUT.exr|OUT.png ...]   (scripted window, for tests)
@@ -57,7 +58,8 @@ int run(int argc, char** argv) {
   double step = 0.5, exposure = 0.0;
   bool quiet = false;
   bool no_refraction = false, no_scattering = false, no_fresnel = false, no_attenuation = false,
-       no_emission = false, no_dispersion = false, no_ground = false, no_skip = false, bricks = false;
+       no_emission = false, no_dispersion = false, no_ground = false, no_skip = false, bricks = false,
+       no_reflect_objects = false;
   CLI::App app{"viewer: render refractive volumes along curved rays (thesis §5, §6.3)", "viewer"};
   app.add_option("input", input, "SCENE.json or VOLUME.vol.json")->required();
   app.add_option("--render", output, "render headless into OUT.exr (linear) or OUT.png (tone-mapped)");
@@ -79,6 +81,9 @@ int run(int argc, char** argv) {
   app.add_flag("--no-emission", no_emission, "leave out emission");
   app.add_flag("--no-dispersion", no_dispersion, "one ray for R, G and B even where a dispersion field exists");
   app.add_flag("--no-ground", no_ground, "leave out the scene's ground plane");
+  app.add_flag("--no-reflect-objects", no_reflect_objects,
+               "reflections see the ground and the environment only (default: the first reflection off an "
+               "object's outside is traced through the other objects and onto the ground)");
   app.add_flag("--no-skip", no_skip, "no empty-space skipping: march the whole box of every volume, and at most a voxel a step between sharp surfaces");
   app.add_flag("--bricks", bricks, "cross homogeneous 4x4x4-voxel bricks in one step (off: on llvmpipe it rarely pays)");
   app.add_option("--exposure", exposure, "exposure in EV for PNG output (default: the scene's render.exposure, else 0)");
@@ -197,6 +202,7 @@ int run(int argc, char** argv) {
   settings.emission = !no_emission;
   settings.dispersion = !no_dispersion;
   settings.ground = !no_ground;
+  settings.reflect_objects = !no_reflect_objects;
   settings.skip_empty_space = !no_skip;
   settings.homogeneous_bricks = bricks;
   settings.output = output_text == "exit-position"    ? RenderOutput::ExitPosition

@@ -91,11 +91,16 @@ std::string objectBricksSampler(std::size_t object) { return "uO" + std::to_stri
 gl::ShaderDefines raymarchDefines(const RenderSettings& settings, const RaymarchScene& scene) {
   gl::ShaderDefines d;
   d.emplace_back("OBJECT_COUNT", std::to_string(scene.objects));
-  d.emplace_back("MAX_SEGMENTS", std::to_string(2 * scene.objects + 1));
+  // Segments of the march through the boxes: each box entered once or twice, and as many again
+  // for the reflection traced after the ray (REFLECT_OBJECTS).
+  const bool reflect_objects =
+      settings.fresnel && settings.reflect_objects && settings.output == RenderOutput::Radiance;
+  d.emplace_back("MAX_SEGMENTS", std::to_string((reflect_objects ? 2 : 1) * (2 * scene.objects + 1)));
   d.emplace_back("LIGHT_COUNT", std::to_string(std::min(scene.lights, kMaxLights)));
   if (settings.ground && scene.ground) d.emplace_back("GROUND", "1");
   if (settings.ground && scene.ground && scene.ground_map) d.emplace_back("GROUND_MAP", "1");
   if (settings.fresnel) d.emplace_back("FRESNEL", "1");
+  if (reflect_objects) d.emplace_back("REFLECT_OBJECTS", "1");
   if (settings.attenuation) d.emplace_back("ATTENUATION", "1");
   if (settings.emission) d.emplace_back("EMISSION", "1");
   if (settings.scattering) d.emplace_back("SCATTERING", "1");

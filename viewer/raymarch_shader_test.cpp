@@ -44,9 +44,10 @@ TEST(RaymarchDefines, FollowTheSettingsAndTheScene) {
   scene.environment = {{"ENV_SKY", "1"}};
   const gl::ShaderDefines all = raymarchDefines(RenderSettings{}, scene);
   EXPECT_TRUE(hasDefine(all, "OBJECT_COUNT", "3"));
-  EXPECT_TRUE(hasDefine(all, "MAX_SEGMENTS", "7"));
+  EXPECT_TRUE(hasDefine(all, "MAX_SEGMENTS", "14"));  // 2·3 + 1, twice: the ray and its reflection
   EXPECT_TRUE(hasDefine(all, "LIGHT_COUNT", "8"));  // kMaxLights
-  for (const char* name : {"GROUND", "FRESNEL", "ATTENUATION", "EMISSION", "SCATTERING", "DISPERSION", "ENV_SKY"})
+  for (const char* name :
+       {"GROUND", "FRESNEL", "REFLECT_OBJECTS", "ATTENUATION", "EMISSION", "SCATTERING", "DISPERSION", "ENV_SKY"})
     EXPECT_TRUE(hasDefine(all, name)) << name;
   for (const char* name : {"NO_REFRACTION", "RK4", "SKIP_HOMOGENEOUS", "OUTPUT_EXIT_POSITION", "OUTPUT_EXIT_DIRECTION"})
     EXPECT_FALSE(definesName(all, name)) << name;
@@ -61,7 +62,13 @@ TEST(RaymarchDefines, FollowTheSettingsAndTheScene) {
   const gl::ShaderDefines some = raymarchDefines(settings, scene);
   for (const char* name : {"RK4", "NO_REFRACTION", "SKIP_HOMOGENEOUS", "OUTPUT_EXIT_DIRECTION"})
     EXPECT_TRUE(hasDefine(some, name)) << name;
-  for (const char* name : {"FRESNEL", "GROUND", "DISPERSION"}) EXPECT_FALSE(definesName(some, name)) << name;
+  for (const char* name : {"FRESNEL", "REFLECT_OBJECTS", "GROUND", "DISPERSION"})
+    EXPECT_FALSE(definesName(some, name)) << name;
+  EXPECT_TRUE(hasDefine(some, "MAX_SEGMENTS", "7"));
+  RenderSettings sky_only;
+  sky_only.reflect_objects = false;
+  EXPECT_FALSE(definesName(raymarchDefines(sky_only, scene), "REFLECT_OBJECTS"));
+  EXPECT_TRUE(hasDefine(raymarchDefines(sky_only, scene), "MAX_SEGMENTS", "7"));
 
   scene.ground = false;
   scene.dispersive = false;

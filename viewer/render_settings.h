@@ -34,6 +34,10 @@ struct RenderSettings {
   bool emission = true;      // L_e
   bool dispersion = true;    // R, G, B follow their own rays where a `dispersion` field exists
   bool ground = true;        // the scene's ground plane, if it has one
+  // One bounce through the scene: the first reflection off an object's outside is traced as a ray
+  // of its own through the other objects and onto the ground (off: it sees the ground and the
+  // environment only, as every other reflection does). Needs `fresnel`.
+  bool reflect_objects = true;
   // March only the box of a volume's non-trivial region (straight elsewhere), and between sharp
   // surfaces of constant n step as far as the distance to the next surface allows (object.glsl
   // stepLength@).

@@ -291,6 +291,7 @@ struct SceneRenderer::Impl {
     p.set("uEye", glm::vec3(camera.eye));
     const float pixel_spread = static_cast<float>(2.0 * std::tan(glm::radians(camera.fov_y_deg) / 2) / size.y);
     p.set("uPixelSpread", pixel_spread);
+    if (p.hasUniform("uTraceLegs")) p.set("uTraceLegs", 2);  // REFLECT_OBJECTS
     p.set("uMinTransmittance", static_cast<float>(settings.min_transmittance));
     p.set("uMaxOpticalDepth", static_cast<float>(-std::log(std::max(settings.min_transmittance, 1e-30))));
 

@@ -441,6 +441,64 @@ TEST_F(SharpViewerTest, AReflectionSeesTheGround) {
   }
 }
 
+// A reflection sees the other objects (REFLECT_OBJECTS, one bounce): the black glass block above
+// mirrors the view 30° down towards +z into a second object, a box of air that glows with emission
+// e = 10 per unit length over z ∈ [0.7, 1.3] (below the view's own path, so that only the mirrored
+// ray crosses it), under a black sky with no ground. The face shows R(30°) times what an eye at the
+// mirror point sees along the mirrored ray: the glow over 0.6 / cos 30° = 0.693, e·0.693 = 6.93
+// (within the 3 % EmissionIntegratesAlongTheRay allows the march's last step in a box). Seeing
+// only the sky, as every reflection did before, the face would be black, which
+// --no-reflect-objects still gives.
+TEST_F(SharpViewerTest, AReflectionSeesTheOtherObjects) {
+  const double theta = glm::radians(30.0);
+  const double e = 10.0, path = 0.6 / std::cos(theta);
+  const double R = reference::fresnelReflectance(1.0, 1.5, std::cos(theta));
+  Volume glow;
+  glow.grid.dims = glm::ivec3(16);
+  glow.grid.bounds_min = glm::dvec3(-0.5, -0.1, 0.7);
+  glow.grid.bounds_max = glm::dvec3(0.5, 0.5, 1.3);
+  std::fill_n(glow.addField("ior", 1).data.begin(), glow.grid.count(), 1.0f);
+  glow.addField("ior_grad", 3);
+  std::fill_n(glow.addField("emission", 3).data.begin(), 3 * glow.grid.count(), static_cast<float>(e));
+  Scene scene;
+  scene.objects.resize(2);
+  scene.environment.uniform = glm::dvec3(0.0);
+  LoadedScene loaded = sceneFromVolumes(
+      scene, {sharpVolume("procedural:box,size=0.4,center=0:0.5:0,ior=1.5,sigma_a=400:400:400", 48,
+                          box({-0.3, 0.2, -0.3}, {0.3, 0.8, 0.3})),
+              glow});
+  loaded.scene.lights.clear();
+  const glm::dvec3 d = glm::normalize(glm::dvec3(0.0, -std::sin(theta), -std::cos(theta))), target(0.0, 0.55, 0.2);
+  const auto meanOf = [](const Image& image) {
+    double mean = 0.0;
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 8; ++x) mean += image.at(x, y)[1] / 64.0;
+    return mean;
+  };
+  const auto faceShows = [&](const RenderSettings& settings) {
+    return meanOf(SceneRenderer(*shaders_, loaded, settings).render(lookAlong(target - 1.0 * d, d, 1.0), {8, 8}));
+  };
+  const double seen = faceShows(RenderSettings{});
+  RenderSettings sky_only;
+  sky_only.reflect_objects = false;
+  const double without = faceShows(sky_only);
+  // The glow alone, seen from the mirror point along the mirrored ray.
+  Scene alone;
+  alone.objects.resize(1);
+  alone.environment.uniform = glm::dvec3(0.0);
+  LoadedScene glow_alone = sceneFromVolumes(alone, {glow});
+  glow_alone.scene.lights.clear();
+  const glm::dvec3 mirrored(0.0, -std::sin(theta), std::cos(theta));
+  const double direct = meanOf(SceneRenderer(*shaders_, glow_alone, RenderSettings{}).render(lookAlong(target, mirrored, 1.0), {8, 8}));
+  std::printf("the face mirrors the glow: %.5f, R·(the glow seen directly, %.4f; e·L = %.4f) = %.5f; reflecting the "
+              "sky only: %.5f\n",
+              seen, direct, e * path, R * direct, without);
+  EXPECT_NEAR(direct, e * path, 0.03 * e * path);
+  // As AReflectionSeesTheGround: 2 % for the float march and the face found to a fraction of a voxel.
+  EXPECT_NEAR(seen, R * direct, 0.02 * R * direct);
+  EXPECT_LT(without, 1e-4);
+}
+
 // Two absorbing, scattering glasses stacked along the view (A: z in [0, 0.5], n 1.5; B: z in
 // [−0.5, 0], n 1.7; each its own slot, each σa and ω̂ one constant: slotMedia finds them, and the
 // march reads them by the material it is in), under a uniform baked light E along l, black sky,

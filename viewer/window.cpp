@@ -118,7 +118,7 @@ bool sameControls(const RenderSettings& a, const RenderSettings& b) {
   return a.step_voxels == b.step_voxels && a.integrator == b.integrator && a.refraction == b.refraction &&
          a.scattering == b.scattering && a.fresnel == b.fresnel && a.attenuation == b.attenuation &&
          a.emission == b.emission && a.dispersion == b.dispersion && a.ground == b.ground &&
-         a.skip_empty_space == b.skip_empty_space;
+         a.skip_empty_space == b.skip_empty_space && a.reflect_objects == b.reflect_objects;
 }
 
 }  // namespace
@@ -303,6 +303,8 @@ int runViewerWindow(const LoadedScene& scene, const RenderSettings& initial_sett
       ImGui::SameLine();
       ImGui::Checkbox("dispersion", &wanted.dispersion);
       ImGui::Checkbox("ground", &wanted.ground);
+      ImGui::SameLine();
+      ImGui::Checkbox("reflect objects", &wanted.reflect_objects);
       ImGui::SameLine();
       ImGui::Checkbox("skip empty space", &wanted.skip_empty_space);
       ImGui::Separator();

@@ -21,6 +21,7 @@ uniform sampler2D uO@Receiver;  // the receiver map of the ground (core/receiver
 // The light a reflection (or any branch the march does not follow) sees: the ground or the
 // environment (defined below, after the ground's helpers it uses).
 vec3 branchRadiance@(vec3 pVol, vec3 dVol);
+void takeBranch@(inout Ray r, vec3 weight, vec3 pVol, vec3 dVol, bool fromOutside);
 
 // The state of a ray inside this object, in the volume's own space.
 struct March@ {
@@ -175,7 +176,7 @@ void crossBoundary@(inout Ray r, float n1, float n2, vec3 dIn, vec3 gradPeak, ve
     vec4 reflectTint = volumeReflect(uvwPeak);
     vec3 tint = mix(vec3(1.0), reflectTint.rgb, clamp(reflectTint.a, 0.0, 1.0));
     vec3 pPeak = uObjBoundsMin[@] + uvwPeak * (uObjBoundsMax[@] - uObjBoundsMin[@]);
-    r.radiance += TBefore * R * tint * branchRadiance@(pPeak, reflect(dIn, normal));
+    takeBranch@(r, TBefore * R * tint, pPeak, reflect(dIn, normal), n1 < 1.001);
   }
 #endif
 }
@@ -245,7 +246,7 @@ void enterSharpFace@(inout Ray r, inout March@ m) {
     outward = normalize(outward);
 #ifdef FRESNEL
     float R = fresnelReflectance(1.0, m.n, abs(dot(d, outward)));
-    r.radiance += r.T * R * branchRadiance@(m.x, reflect(d, outward));
+    takeBranch@(r, r.T * R, m.x, reflect(d, outward), true);
     r.T *= 1.0 - R;
 #endif
     d = refract(d, outward, 1.0 / m.n);
@@ -271,6 +272,23 @@ vec3 branchRadiance@(vec3 pVol, vec3 dVol) {
   }
 #endif
   return environmentRadiance(dw, uReflectionLod);
+}
+
+// The branch a surface does not follow, of weight `weight` (volume-space point and direction): the
+// first one that leaves the object's outside for the air, on the primary ray, is recorded for a
+// trace of its own through the scene (REFLECT_OBJECTS; raymarch.frag gRecordBranch); any other is
+// looked up here (branchRadiance@).
+void takeBranch@(inout Ray r, vec3 weight, vec3 pVol, vec3 dVol, bool fromOutside) {
+#ifdef REFLECT_OBJECTS
+  if (gRecordBranch && fromOutside && !r.dispersed && dot(gBranchWeight, vec3(1.0)) <= 0.0) {
+    gBranchWeight = weight;
+    gBranchX = (uObjVolToWorld[@] * vec4(pVol, 1.0)).xyz;
+    gBranchD = normalize(mat3(uObjVolToWorld[@]) * dVol);
+    gBranchObject = @;
+    return;
+  }
+#endif
+  r.radiance += weight * branchRadiance@(pVol, dVol);
 }
 
 // Whether the ray, in air, is below the ground plane (GROUND) and has not been found below it
@@ -682,7 +700,8 @@ bool crossInterface@(inout Ray r, inout March@ m, float cauchy) {
   float R = fresnelUnpolarised(n1, n2, cosI, sqrt(1.0 - sin2T));
   bool reflects = R > 0.5;
   // The branch not followed, looked up once (llvmpipe would run both calls of an if/else).
-  r.radiance += r.T * exp(-m.tau) * (reflects ? 1.0 - R : R) * branchRadiance@(p, reflects ? refracted : mirrored);
+  takeBranch@(r, r.T * exp(-m.tau) * (reflects ? 1.0 - R : R), p, reflects ? refracted : mirrored,
+              !reflects && m.medium < 0);
   if (reflects) {
     r.T *= R;
     m.w = mirrored * n1;

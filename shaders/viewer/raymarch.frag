@@ -152,6 +152,21 @@ const int EVENT_OPAQUE = 4;    // an opaque embedding is here (HAS_OPAQUE)
 // channel: surfaces crossed, total internal reflections, box faces; 2026-12 measurement).
 const int kMaxEventsPerObject = 128;
 
+// One bounce of reflection through the scene (REFLECT_OBJECTS; docs/physics.md "Reflections"):
+// the first light an object's outside reflects towards the eye is not looked up in the ground and
+// the environment where it happens (each object's branchRadiance) but recorded here, and traced after the
+// primary ray as a ray of its own (shade), through the other objects and onto the ground. Every
+// other branch, and every branch of that second ray, is looked up where it happens. GLSL has no
+// recursion; the second trace is a second call of trace from main's level.
+bool gRecordBranch = false;     // the primary ray's trace is on: record its first outside reflection
+vec3 gBranchWeight = vec3(0.0);  // its weight (T·R·tint where it left); 0: none recorded
+vec3 gBranchX = vec3(0.0);       // where it leaves (world) and where it goes (world, unit)
+vec3 gBranchD = vec3(0.0, 1.0, 0.0);
+int gBranchObject = -1;          // the object it leaves, which it does not meet again (convex)
+Ray gBranchRay;                  // the reflection once traced (done from the start when none)
+uniform int uTraceLegs;          // 2: the primary ray and its reflection (a uniform: a loop the
+                                 // compiler cannot unroll into two copies of what it calls)
+
 // Every object's march (march0, march1, ...): viewer/raymarch_shader.cpp puts one instance of
 // viewer/object.glsl per object in place of the next line.
 // @OBJECTS@
@@ -201,9 +216,18 @@ vec3 groundRadiance(vec3 xw) {
 }
 #endif
 
-// Follows the ray through the objects it meets, nearest box first, and onto the ground.
-void trace(inout Ray r, float cauchy) {
-  int last = -1;
+// Follows the ray through the objects it meets, nearest box first, and onto the ground; it starts
+// outside object `skip`'s reach (−1: none), as a ray leaving a convex object does. With
+// REFLECT_OBJECTS the reflection the ray recorded goes on in its place once it is through, in the
+// same loop (one copy of every march in the program), and ends in gBranchRay.
+void trace(inout Ray r, float cauchy, int skip) {
+  int last = skip;
+#ifdef REFLECT_OBJECTS
+  Ray primary = r;
+  bool second = false;
+  gBranchRay = r;
+  gBranchRay.done = true;
+#endif
   for (int segment = 0; segment < MAX_SEGMENTS; ++segment) {
     float tBest = 1e30;
     int next = -1;
@@ -226,16 +250,52 @@ void trace(inout Ray r, float cauchy) {
       r.done = true;
     }
 #endif
-    if (r.done || next < 0) break;
-    r.x += tBest * r.d;
-    marchObject(next, r, cauchy);
-    if (r.done) break;
-    last = next;
+    bool ended = r.done || next < 0;
+    if (!ended) {
+      r.x += tBest * r.d;
+      marchObject(next, r, cauchy);
+      ended = r.done;
+      last = next;
+    }
+#ifdef REFLECT_OBJECTS
+    if (ended && !second && gRecordBranch && dot(gBranchWeight, vec3(1.0)) > 0.0) {
+      // Through: the reflection goes on from where it left, the primary ray waits.
+      primary = r;
+      second = true;
+      gRecordBranch = false;
+      r.x = gBranchX;
+      r.d = gBranchD;
+      r.radiance = vec3(0.0);
+      r.T = vec3(1.0);
+      r.done = false;
+      r.grounded = false;
+      r.groundWeight = vec3(0.0);
+      last = gBranchObject;
+      continue;
+    }
+#endif
+    if (ended) break;
   }
+#ifdef REFLECT_OBJECTS
+  if (second) {
+    gBranchRay = r;
+    r = primary;
+  }
+#endif
 #ifdef GROUND
   // The ground's shading, in one place for every way the ray can end on it (llvmpipe's cost grew
-  // with each place it was written out: 25 % of the museum's frame).
+  // with each place it was written out: 25 % of the museum's frame): for the ray, and for its
+  // reflection (REFLECT_OBJECTS) in a second turn of a loop the compiler cannot unroll.
+#ifdef REFLECT_OBJECTS
+  for (int leg = 0; leg < uTraceLegs; ++leg) {
+    if (!(leg == 0 ? r.grounded : gBranchRay.grounded)) continue;
+    vec3 L = (leg == 0 ? r.groundWeight : gBranchRay.groundWeight) * groundRadiance(leg == 0 ? r.x : gBranchRay.x);
+    if (leg == 0) r.radiance += L;
+    else gBranchRay.radiance += L;
+  }
+#else
   if (r.grounded) r.radiance += r.groundWeight * groundRadiance(r.x);
+#endif
 #endif
 }
 
@@ -265,10 +325,52 @@ vec3 finish(Ray r) {
   return r.radiance + r.T * environmentRadiance(r.d, lod);
 }
 
+// A primary ray traced at one wavelength (its Cauchy term) and, with REFLECT_OBJECTS, the one
+// reflection it recorded, traced after it; finishShaded adds them (in uniform control flow: finish
+// takes derivatives).
+struct Shaded {
+  Ray r;
+  Ray branch;  // done from the start when no reflection was recorded
+  vec3 weight;
+};
+
+Shaded traceShaded(float cauchy) {
+  Shaded s;
+  s.r = primaryRay();
+#ifdef REFLECT_OBJECTS
+  gRecordBranch = true;
+  gBranchWeight = vec3(0.0);
+  gBranchObject = -1;
+#endif
+  trace(s.r, cauchy, -1);
+#ifdef REFLECT_OBJECTS
+  gRecordBranch = false;
+  s.branch = gBranchRay;
+  s.weight = gBranchWeight;
+#else
+  s.branch = s.r;
+  s.branch.done = true;
+  s.weight = vec3(0.0);
+#endif
+  return s;
+}
+
+vec3 finishShaded(Shaded s) {
+  vec3 color = finish(s.r);
+#ifdef REFLECT_OBJECTS
+  // The reflection's environment at the reflection lookups' level (its footprint is the
+  // surface's curvature's, which derivatives across pixels of different branches do not give).
+  vec3 branch = s.branch.radiance;
+  if (!s.branch.done) branch += s.branch.T * environmentRadiance(s.branch.d, uReflectionLod);
+  color += s.weight * branch;
+#endif
+  return color;
+}
+
 void main() {
 #if defined(OUTPUT_EXIT_POSITION) || defined(OUTPUT_EXIT_DIRECTION)
   Ray r = primaryRay();
-  trace(r, 0.0);
+  trace(r, 0.0, -1);
 #ifdef OUTPUT_EXIT_POSITION
   outColor = vec4(r.exitX, r.entered ? 1.0 : 0.0);
 #else
@@ -283,31 +385,23 @@ void main() {
 #if defined(DISPERSION_GREEN_PASS)
   // Two passes (SceneRenderer::draw): green here, and in the depth buffer where it went through
   // dispersive glass (0) or not (1); red and blue follow in a pass the depth test confines there.
-  Ray green = primaryRay();
-  trace(green, cauchy[1]);
-  gl_FragDepth = green.dispersed ? 0.0 : 1.0;
-  outColor = vec4(finish(green), 1.0);
+  Shaded green = traceShaded(cauchy[1]);
+  gl_FragDepth = green.r.dispersed ? 0.0 : 1.0;
+  outColor = vec4(finishShaded(green), 1.0);
 #elif defined(DISPERSION_RED_BLUE_PASS)
-  Ray red = primaryRay();
-  trace(red, cauchy[0]);
-  Ray blue = primaryRay();
-  trace(blue, cauchy[2]);
-  outColor = vec4(finish(red).r, 0.0, finish(blue).b, 1.0);  // green's channel is masked off
+  Shaded red = traceShaded(cauchy[0]);
+  Shaded blue = traceShaded(cauchy[2]);
+  outColor = vec4(finishShaded(red).r, 0.0, finishShaded(blue).b, 1.0);  // green's channel is masked off
 #else
-  Ray green = primaryRay();
-  trace(green, cauchy[1]);
-  Ray red = green, blue = green;
-  if (green.dispersed) {
-    red = primaryRay();
-    trace(red, cauchy[0]);
-    blue = primaryRay();
-    trace(blue, cauchy[2]);
+  Shaded green = traceShaded(cauchy[1]);
+  Shaded red = green, blue = green;
+  if (green.r.dispersed) {
+    red = traceShaded(cauchy[0]);
+    blue = traceShaded(cauchy[2]);
   }
-  outColor = vec4(finish(red).r, finish(green).g, finish(blue).b, 1.0);  // uniform control flow
+  outColor = vec4(finishShaded(red).r, finishShaded(green).g, finishShaded(blue).b, 1.0);  // uniform control flow
 #endif
 #else
-  Ray r = primaryRay();
-  trace(r, 0.0);
-  outColor = vec4(finish(r), 1.0);
+  outColor = vec4(finishShaded(traceShaded(0.0)), 1.0);
 #endif
 }
