@@ -435,14 +435,20 @@ ReceiverMap bakeSphereUnderTheSunsDisc(int res, double angular_diameter_deg, dou
   return sum.finish().receivers.at(0);
 }
 
-TEST(ExactOpticsSoftSun, TheSunsDiscCastsThePenumbraOfGeometry) {
-  constexpr double kTheta = 6.0, kHeight = 1.5;
-  double x80 = 0.0;  // f(x) = 0.8 by bisection
+// The width between the 20 % and 80 % levels of the penumbra a disc of angular diameter θ casts
+// from an edge at height L: 2·x₈₀·(θ/2)·L with f(x₈₀) = 0.8 (above; bisection).
+double geometricPenumbra(double theta_deg, double height) {
+  double x80 = 0.0;
   for (double a = 0.0, b = 1.0; b - a > 1e-12; x80 = 0.5 * (a + b)) {
     const double m = 0.5 * (a + b);
     (0.5 + (m * std::sqrt(1.0 - m * m) + std::asin(m)) / std::numbers::pi < 0.8 ? a : b) = m;
   }
-  const double geometric = 2.0 * x80 * glm::radians(0.5 * kTheta) * kHeight;
+  return 2.0 * x80 * glm::radians(0.5 * theta_deg) * height;
+}
+
+TEST(ExactOpticsSoftSun, TheSunsDiscCastsThePenumbraOfGeometry) {
+  constexpr double kTheta = 6.0, kHeight = 1.5;
+  const double geometric = geometricPenumbra(kTheta, kHeight);
   const Penumbra coarse = penumbraOf(bakeSphereUnderTheSunsDisc(32, kTheta));
   const Penumbra soft = penumbraOf(bakeSphereUnderTheSunsDisc(48, kTheta));
   const Penumbra hard = penumbraOf(bakeSphereUnderTheSunsDisc(48, 0.0));
@@ -466,12 +472,7 @@ TEST(ExactOpticsSoftSun, TheSunsDiscCastsThePenumbraOfGeometry) {
 // (r 0.80–0.85 and 1.15–1.20).
 TEST(ExactOpticsSoftSun, TheRealSunsHalfDegreeCastsThePenumbraOfGeometry) {
   constexpr double kTheta = 0.53, kHeight = 18.5;
-  double x80 = 0.0;  // f(x) = 0.8 by bisection
-  for (double a = 0.0, b = 1.0; b - a > 1e-12; x80 = 0.5 * (a + b)) {
-    const double m = 0.5 * (a + b);
-    (0.5 + (m * std::sqrt(1.0 - m * m) + std::asin(m)) / std::numbers::pi < 0.8 ? a : b) = m;
-  }
-  const double geometric = 2.0 * x80 * glm::radians(0.5 * kTheta) * kHeight;
+  const double geometric = geometricPenumbra(kTheta, kHeight);
   PenumbraWindow window;
   window.from = 0.78;
   window.inside_lo = 0.80;
@@ -524,12 +525,9 @@ TEST(ExactOpticsSoftLight, ABallLightCastsThePenumbraOfGeometry) {
   constexpr double kRho = 0.3, kHeight = 6.0, kCentre = 1.5;
   const double d = kHeight - kCentre, beta = std::asin(1.0 / d);
   const double d_s = std::sqrt(d * d - 1.0), d_f = kHeight / std::cos(beta);
-  double x80 = 0.0;  // f(x) = 0.8 for a straight edge across a uniform disc, by bisection
-  for (double a = 0.0, b = 1.0; b - a > 1e-12; x80 = 0.5 * (a + b)) {
-    const double m = 0.5 * (a + b);
-    (0.5 + (m * std::sqrt(1.0 - m * m) + std::asin(m)) / std::numbers::pi < 0.8 ? a : b) = m;
-  }
-  const double geometric = 2.0 * x80 * kRho * (d_f - d_s) / d_s / std::cos(beta);
+  // The disc's angular radius ρ/D_S seen from the silhouette, D_F − D_S on to the floor, 1/cos β
+  // across it.
+  const double geometric = geometricPenumbra(2.0 * glm::degrees(kRho / d_s), d_f - d_s) / std::cos(beta);
   const PenumbraWindow window{1.15, 1.20, 1.25, 1.48, 1.53};
   const Penumbra coarse = penumbraOf(bakeSphereUnderABallLight(32, kRho), window);
   const Penumbra soft = penumbraOf(bakeSphereUnderABallLight(48, kRho), window);

@@ -167,6 +167,22 @@ inline GridSpec cubicGrid(int res, double half) {
   return g;
 }
 
+// A graded index n = n0 + g·x on `grid` (∇n = (g, 0, 0) exactly), filling its box.
+inline Volume linearIorVolume(const GridSpec& grid, double n0, double g) {
+  Volume v;
+  v.grid = grid;
+  Field& ior = v.addField("ior", 1);
+  Field& grad = v.addField("ior_grad", 3);
+  for (int k = 0; k < grid.dims.z; ++k)
+    for (int j = 0; j < grid.dims.y; ++j)
+      for (int i = 0; i < grid.dims.x; ++i) {
+        const std::size_t index = grid.index(i, j, k);
+        ior.data[index] = static_cast<float>(n0 + g * grid.center(i, j, k).x);
+        grad.voxel(index)[0] = static_cast<float>(g);
+      }
+  return v;
+}
+
 // ---------------------------------------------------------------------------------------------
 // The scenes of the tests.
 

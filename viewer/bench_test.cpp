@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "gl/context.h"
+#include "lightsim/test_scenes.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -16,22 +17,7 @@ namespace eik {
 namespace {
 
 // A 16³ cube [-0.5, 0.5]³ with n = n0 + g·x.
-Volume cube(float n0, float g) {
-  Volume v;
-  v.grid.dims = glm::ivec3(16);
-  v.grid.bounds_min = glm::dvec3(-0.5);
-  v.grid.bounds_max = glm::dvec3(0.5);
-  Field& ior = v.addField("ior", 1);
-  Field& grad = v.addField("ior_grad", 3);
-  for (int k = 0; k < 16; ++k)
-    for (int j = 0; j < 16; ++j)
-      for (int i = 0; i < 16; ++i) {
-        const std::size_t idx = v.grid.index(i, j, k);
-        ior.data[idx] = n0 + g * static_cast<float>(v.grid.center(i, j, k).x);
-        grad.data[3 * idx] = g;
-      }
-  return v;
-}
+Volume cube(float n0, float g) { return test_scenes::linearIorVolume(test_scenes::cubicGrid(16, 0.5), n0, g); }
 
 TEST(Bench, MedianOfOddAndEvenCounts) {
   EXPECT_EQ(medianOf({}), 0.0);

@@ -21,6 +21,7 @@
 #include "core/volume.h"
 #include "lightsim/bake.h"
 #include "lightsim/cpu_simulator.h"
+#include "lightsim/test_scenes.h"
 #include "tests/reference/exact_optics.h"
 #include "viewer/environment.h"
 #include "viewer/loaded_scene.h"
@@ -587,19 +588,7 @@ TEST_F(SceneRendererTest, AnUnevenlyScaledObjectIsItsVolumeStretchedAlongEachAxi
   // z) and leaves into air with t_x = 0.15 (its tangential part kept at the face z = −1.5). The
   // ray drifts 0.19 in x on the way, so n and the path change by about 1 %: 5 % covers that; with
   // ∇n left unscaled the ray leaves at 0.3, with the scale left out at 0.2.
-  Volume grin;
-  grin.grid.dims = glm::ivec3(24);
-  grin.grid.bounds_min = glm::dvec3(-1.0);
-  grin.grid.bounds_max = glm::dvec3(1.0);
-  Field& ior = grin.addField("ior", 1);
-  Field& grad = grin.addField("ior_grad", 3);
-  for (int k = 0; k < 24; ++k)
-    for (int j = 0; j < 24; ++j)
-      for (int i = 0; i < 24; ++i) {
-        const std::size_t v = grin.grid.index(i, j, k);
-        ior.data[v] = static_cast<float>(1.2 + 0.1 * grin.grid.center(i, j, k).x);
-        grad.voxel(v)[0] = 0.1f;
-      }
+  Volume grin = test_scenes::linearIorVolume(test_scenes::cubicGrid(24, 1.0), 1.2, 0.1);
   SceneObjectSpec graded;
   graded.scale = glm::dvec3(2.0, 1.0, 1.5);
   settings.output = RenderOutput::ExitDirection;
