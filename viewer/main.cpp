@@ -4,7 +4,7 @@
 //          [--camera EX,EY,EZ:TX,TY,TZ:FOVY_DEG] [--env FILE | uniform:R,G,B | checker[:R,G,B] | sky]
 //          [--step VOXELS] [--integrator euler|rk4] [--no-refraction] [--no-fresnel] [--no-scattering]
 //          [--no-attenuation] [--no-emission] [--no-dispersion] [--no-ground] [--no-skip]
-//          [--no-reflect-objects]
+//          [--no-reflect-objects] [--bands N]
 //
 //   viewer SCENE.json | VOLUME.vol.json            (no --render: the interactive window, viewer/window.h)
 //          [--window-frames N --save OUT.exr|OUT.png ...]   (scripted window, for tests)
@@ -12,6 +12,7 @@
 //
 // Headless rendering goes through OSMesa/EGL and viewer/scene_renderer.h (the image formation of
 // thesis §5 over every object of the scene, the ground and the environment).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -80,6 +81,11 @@ int run(int argc, char** argv) {
   app.add_flag("--no-attenuation", no_attenuation, "leave out Beer-Lambert absorption");
   app.add_flag("--no-emission", no_emission, "leave out emission");
   app.add_flag("--no-dispersion", no_dispersion, "one ray for R, G and B even where a dispersion field exists");
+  int bands = 0;
+  app.add_option("--bands", bands,
+                 "spectral bands of the dispersion, 3 (R, G, B) or 4..16 weighted by the CIE 1931 functions, as "
+                 "lightsim --bands (default: the bands the objects were baked with, else 3)")
+      ->check(CLI::Range(3, 16));
   app.add_flag("--no-ground", no_ground, "leave out the scene's ground plane");
   app.add_flag("--no-reflect-objects", no_reflect_objects,
                "reflections see the ground and the environment only (default: the first reflection off an "
@@ -201,7 +207,13 @@ int run(int argc, char** argv) {
   settings.attenuation = !no_attenuation;
   settings.emission = !no_emission;
   settings.dispersion = !no_dispersion;
-  settings.ground = !no_ground;
+  // The bands the bake used (its manifest's bake_bands), so that the glass shows the spectrum its
+  // caustic was baked in; 3 when none says more.
+  settings.bands = 3;
+  for (const LoadedObject& object : scene.objects)
+    if (const auto it = object.volume.metadata.find("bake_bands"); it != object.volume.metadata.end() && it->is_number_integer())
+      settings.bands = std::clamp(std::max(settings.bands, it->get<int>()), 3, 16);
+  if (app.count("--bands")) settings.bands = bands;
   settings.reflect_objects = !no_reflect_objects;
   settings.skip_empty_space = !no_skip;
   settings.homogeneous_bricks = bricks;

@@ -110,7 +110,10 @@ gl::ShaderDefines raymarchDefines(const RenderSettings& settings, const Raymarch
   if (settings.skip_empty_space) d.emplace_back("SKIP_TO_SURFACES", "1");
   if (settings.output == RenderOutput::ExitPosition) d.emplace_back("OUTPUT_EXIT_POSITION", "1");
   else if (settings.output == RenderOutput::ExitDirection) d.emplace_back("OUTPUT_EXIT_DIRECTION", "1");
-  else if (settings.dispersion && scene.dispersive) d.emplace_back("DISPERSION", "1");
+  else if (settings.dispersion && scene.dispersive) {
+    d.emplace_back("DISPERSION", "1");
+    if (settings.bands != 3) d.emplace_back("DISPERSION_BANDS", std::to_string(settings.bands));
+  }
   for (const auto& e : scene.environment) d.push_back(e);
   return d;
 }

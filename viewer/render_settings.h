@@ -33,6 +33,10 @@ struct RenderSettings {
   bool attenuation = true;   // Beer–Lambert, per channel
   bool emission = true;      // L_e
   bool dispersion = true;    // R, G, B follow their own rays where a `dispersion` field exists
+  // Spectral bands of the dispersion (core/spectrum.h spectralBands, as `lightsim --bands`): 3 traces
+  // R, G and B at 0.61, 0.55, 0.465 µm; 4 … 16 trace that many bands over 0.38 – 0.78 µm, each
+  // weighted by its CIE share of R, G and B (where the draw target has a depth buffer; else 3).
+  int bands = 3;
   bool ground = true;        // the scene's ground plane, if it has one
   // One bounce through the scene: the first reflection off an object's outside is traced as a ray
   // of its own through the other objects and onto the ground (off: it sees the ground and the

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/spectrum.h"
 #include "core/interfaces.h"
 #include "gl/framebuffer.h"
 #include "gl/gl.h"
@@ -292,6 +293,16 @@ struct SceneRenderer::Impl {
     const float pixel_spread = static_cast<float>(2.0 * std::tan(glm::radians(camera.fov_y_deg) / 2) / size.y);
     p.set("uPixelSpread", pixel_spread);
     if (p.hasUniform("uTraceLegs")) p.set("uTraceLegs", 2);  // REFLECT_OBJECTS
+    if (p.hasUniform("uBandCount")) {  // DISPERSION_BANDS
+      const std::vector<SpectralBand> bands = spectralBands(settings.bands);
+      p.set("uBandCount", static_cast<int>(bands.size()));
+      for (std::size_t b = 0; b < bands.size(); ++b) {
+        const std::string index = "[" + std::to_string(b) + "]";
+        const double lambda = bands[b].lambda_um;
+        p.set("uBandCauchy" + index, static_cast<float>(cauchyTerm(lambda)));
+        p.set("uBandRgb" + index, glm::vec3(bands[b].rgb));
+      }
+    }
     p.set("uMinTransmittance", static_cast<float>(settings.min_transmittance));
     p.set("uMaxOpticalDepth", static_cast<float>(-std::log(std::max(settings.min_transmittance, 1e-30))));
 
@@ -510,7 +521,8 @@ void SceneRenderer::draw(const Camera& camera, glm::ivec2 size) {
   s.triangle.draw();
   glDepthFunc(GL_GREATER);
   glDepthMask(GL_FALSE);
-  glColorMask(GL_TRUE, GL_FALSE, GL_TRUE, GL_FALSE);
+  // Three bands: red and blue here, green's from the first pass; N bands: every channel here.
+  glColorMask(GL_TRUE, s.settings.bands == 3 ? GL_FALSE : GL_TRUE, GL_TRUE, GL_FALSE);
   s.red_blue.use();
   s.triangle.draw();
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);

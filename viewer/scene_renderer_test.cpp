@@ -724,6 +724,45 @@ TEST_F(SceneRendererTest, DispersionInTwoPassesIsTheOnePassImage) {
   EXPECT_NEAR(splitTwo, splitOne, 0.05 * splitOne);
 }
 
+// The dispersion in N spectral bands (RenderSettings::bands, as lightsim --bands): each band
+// traced at its n(λ_b) and weighted by its share of R, G and B, in every channel of the second
+// pass. One band (λ_d, carrying everything) is the image without dispersion; sixteen bands of a
+// glass whose Cauchy B is 0 (the field there, so that every band is traced) are that image too,
+// the shares summing to 1 per channel; with B ≠ 0 the sixteen split the colours as the three do.
+// Exact but for float rounding of the sixteen-term sum: 10⁻⁵.
+TEST_F(SceneRendererTest, DispersionInSpectralBands) {
+  Volume volume = smoothedVolume(ball({0, 0, 0}, 0.5), 1.5, glm::dvec3(0.0), 40);
+  Volume flat = volume;
+  flat.addField("dispersion", 1);  // B = 0: every band bends alike
+  Field& dispersion = volume.addField("dispersion", 1);
+  const Field& ior = *volume.find("ior");
+  for (std::size_t i = 0; i < volume.grid.count(); ++i) dispersion.data[i] = 0.04f * (ior.data[i] - 1.0f) / 0.5f;
+  const Camera camera = lookAt({0, 0, 4}, {0, 0, 0}, 20.0);
+  const glm::ivec2 size{32, 32};
+  RenderSettings plain_settings, one, sixteen;
+  plain_settings.dispersion = false;
+  one.bands = 1;
+  sixteen.bands = 16;
+  const Image plain = render(oneObject(volume, "checker:1,1,1"), camera, size, plain_settings);
+  const Image single = render(oneObject(volume, "checker:1,1,1"), camera, size, one);
+  const Image alike = render(oneObject(flat, "checker:1,1,1"), camera, size, sixteen);
+  const Image spectral = render(oneObject(volume, "checker:1,1,1"), camera, size, sixteen);
+  double one_worst = 0.0, alike_worst = 0.0, split = 0.0;
+  for (int y = 0; y < size.y; ++y)
+    for (int x = 0; x < size.x; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        one_worst = std::max(one_worst, static_cast<double>(std::abs(single.at(x, y)[c] - plain.at(x, y)[c])));
+        alike_worst = std::max(alike_worst, static_cast<double>(std::abs(alike.at(x, y)[c] - plain.at(x, y)[c])));
+      }
+      split = std::max(split, static_cast<double>(std::abs(spectral.at(x, y)[0] - spectral.at(x, y)[2])));
+    }
+  save(spectral, "dispersion-16-bands");
+  EXPECT_LT(one_worst, 1e-5);
+  EXPECT_LT(alike_worst, 1e-5);
+  EXPECT_GT(split, 0.3);
+  RecordProperty("worst", std::to_string(one_worst) + " " + std::to_string(alike_worst) + " split " + std::to_string(split));
+}
+
 TEST_F(SceneRendererTest, EnvironmentMapIsSeenInvertedThroughABallLens) {
   // An equirectangular map, red above the horizon and blue below: around the ball the sky is red
   // above the centre, through the ball (which inverts) blue.

@@ -6,7 +6,8 @@
 // T the product of Beer–Lambert attenuation exp(−∫σa ds) (per channel) and the Fresnel
 // transmissions at the boundaries crossed. Objects are found along the ray, nearest box first: a
 // ray leaving one object continues into the next one it meets (so one is seen through another).
-// With DISPERSION, R, G and B follow their own rays at λ = 0.61, 0.55, 0.465 µm (thesis §3.2.7).
+// With DISPERSION, R, G and B follow their own rays at λ = 0.61, 0.55, 0.465 µm (thesis §3.2.7), or
+// with DISPERSION_BANDS N spectral bands, each weighted by its share of R, G and B.
 //
 // Defines (viewer/raymarch_shader.h): OBJECT_COUNT, MAX_SEGMENTS, LIGHT_COUNT; GROUND, FRESNEL, ATTENUATION,
 // EMISSION, SCATTERING, DISPERSION, NO_REFRACTION, RK4; OUTPUT_EXIT_POSITION, OUTPUT_EXIT_DIRECTION;
@@ -166,6 +167,14 @@ int gBranchObject = -1;          // the object it leaves, which it does not meet
 Ray gBranchRay;                  // the reflection once traced (done from the start when none)
 uniform int uTraceLegs;          // 2: the primary ray and its reflection (a uniform: a loop the
                                  // compiler cannot unroll into two copies of what it calls)
+
+#ifdef DISPERSION_BANDS
+// The viewer's spectral bands (RenderSettings::bands ≠ 3): the Cauchy term 1/λ² − 1/λ_d² and the
+// R, G, B share of each.
+uniform int uBandCount;
+uniform float uBandCauchy[DISPERSION_BANDS];
+uniform vec3 uBandRgb[DISPERSION_BANDS];
+#endif
 
 // Every object's march (march0, march1, ...): viewer/raymarch_shader.cpp puts one instance of
 // viewer/object.glsl per object in place of the next line.
@@ -388,6 +397,14 @@ void main() {
   Shaded green = traceShaded(cauchy[1]);
   gl_FragDepth = green.r.dispersed ? 0.0 : 1.0;
   outColor = vec4(finishShaded(green), 1.0);
+#elif defined(DISPERSION_RED_BLUE_PASS) && defined(DISPERSION_BANDS)
+  // N spectral bands, as lightsim --bands bakes them (core/spectrum.h spectralBands): each traced
+  // at its own n(λ_b) and weighted by its share of R, G and B (the shares sum to 1 per channel), in
+  // every channel (SceneRenderer::draw unmasks green for this pass). A loop on a uniform bound:
+  // one copy of the trace in the program.
+  vec3 color = vec3(0.0);
+  for (int b = 0; b < uBandCount; ++b) color += uBandRgb[b] * finishShaded(traceShaded(uBandCauchy[b]));
+  outColor = vec4(color, 1.0);
 #elif defined(DISPERSION_RED_BLUE_PASS)
   Shaded red = traceShaded(cauchy[0]);
   Shaded blue = traceShaded(cauchy[2]);
