@@ -118,6 +118,8 @@ TEST(ViewerCli, BadInputExitsTwo) {
       {{"noior.vol.json", "--render", "x.png"}, "ior"},
       {{"ball.vol.json", "--render", "x.png", "--integrator", "leapfrog"}, "--integrator"},
       {{"ball.vol.json", "--render", "x.png", "--camera", "0,0,1:0,0"}, "--camera"},
+      {{"ball.vol.json", "--render", "x.png", "--bands", "2"}, "--bands"},
+      {{"ball.vol.json", "--render", "x.png", "--bands", "17"}, "--bands"},
   };
   for (const Case& c : cases) {
     ProgramResult r = runProgram(VIEWER_EXE, c.args, dir.path());

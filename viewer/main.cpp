@@ -214,6 +214,7 @@ int run(int argc, char** argv) {
     if (const auto it = object.volume.metadata.find("bake_bands"); it != object.volume.metadata.end() && it->is_number_integer())
       settings.bands = std::clamp(std::max(settings.bands, it->get<int>()), 3, 16);
   if (app.count("--bands")) settings.bands = bands;
+  settings.ground = !no_ground;
   settings.reflect_objects = !no_reflect_objects;
   settings.skip_empty_space = !no_skip;
   settings.homogeneous_bricks = bricks;
