@@ -1,6 +1,8 @@
 #include "core/interfaces.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -151,6 +153,26 @@ InterfaceTable interfaceTable(const Volume& volume, const std::string& source) {
     table.slots.push_back(slot);
   }
   return table;
+}
+
+std::optional<float> unusedSlotDistance(const Field& interfaces, int used) {
+  if (used >= interfaces.components || interfaces.data.empty()) return std::nullopt;
+  const std::size_t stride = static_cast<std::size_t>(interfaces.components);
+  const std::size_t voxels = interfaces.data.size() / stride;
+  const float value = interfaces.data[static_cast<std::size_t>(used)];
+  // In chunks of voxels in parallel; each chunk says whether its unused distances are all `value`.
+  constexpr std::size_t kChunk = std::size_t(1) << 16;
+  const std::size_t chunks = (voxels + kChunk - 1) / kChunk;
+  std::vector<std::uint8_t> constant(chunks, 1);
+  parallelFor(0, static_cast<std::int64_t>(chunks), [&](std::int64_t c) {
+    const std::size_t begin = static_cast<std::size_t>(c) * kChunk, end = std::min(voxels, begin + kChunk);
+    bool same = true;
+    for (std::size_t i = begin; i < end && same; ++i)
+      for (std::size_t k = static_cast<std::size_t>(used); k < stride; ++k) same = same && interfaces.data[i * stride + k] == value;
+    constant[static_cast<std::size_t>(c)] = same ? 1 : 0;
+  });
+  if (!std::all_of(constant.begin(), constant.end(), [](std::uint8_t c) { return c != 0; })) return std::nullopt;
+  return value;
 }
 
 }  // namespace eik

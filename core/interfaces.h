@@ -78,6 +78,12 @@ MaterialValues deepMaterialValues(const Volume& volume, const InterfaceTable& ta
 // cube's corners lie √3/2 edges from its centre, so nothing of another object is blended in.
 constexpr double kDeepVoxels = 1.0;
 
+// The one value every unused slot's distance holds (docs/volume-format.md: +band) in the
+// `interfaces` field (4 components) beyond the first `used` slots, or nullopt where those vary (a
+// hand-made file) or every slot is used. Then the used slots' distances alone describe the field:
+// lightsim's sampler keeps them alone, the viewer uploads them alone.
+std::optional<float> unusedSlotDistance(const Field& interfaces, int used);
+
 // Which material a point is in: the slot index, or −1 for air.
 inline int materialSlot(const glm::dvec4& distances, int slot_count) {
   for (int k = 0; k < slot_count; ++k)

@@ -75,6 +75,27 @@ TEST(Interfaces, MalformedTablesNameTheKey) {
   EXPECT_CONTAINS(inputErrorOf([&] { interfaceTable(no_table); }), "no interfaces table");
 }
 
+TEST(Interfaces, TheUnusedSlotsDistanceIsOneConstantOrNone) {
+  Field d;
+  d.components = 4;
+  const std::size_t voxels = 200000;  // several of the check's chunks
+  d.data.resize(voxels * 4);
+  for (std::size_t i = 0; i < voxels; ++i) {
+    d.data[i * 4] = static_cast<float>(i % 7) - 3.0f;  // slot 0 used
+    d.data[i * 4 + 1] = d.data[i * 4 + 2] = d.data[i * 4 + 3] = 0.05f;  // +band
+  }
+  ASSERT_TRUE(unusedSlotDistance(d, 1).has_value());
+  EXPECT_EQ(*unusedSlotDistance(d, 1), 0.05f);
+  EXPECT_FALSE(unusedSlotDistance(d, 0).has_value());  // slot 0 is not one constant
+  EXPECT_FALSE(unusedSlotDistance(d, 4).has_value());  // nothing unused
+  d.data[(voxels - 1) * 4 + 3] = 0.06f;               // one voxel off, in the last chunk
+  EXPECT_FALSE(unusedSlotDistance(d, 1).has_value());
+  EXPECT_FALSE(unusedSlotDistance(d, 3).has_value());
+  d.data[(voxels - 1) * 4 + 3] = 0.05f;
+  d.data[(voxels - 1) * 4 + 2] = 0.06f;
+  EXPECT_TRUE(unusedSlotDistance(d, 3).has_value());  // slot 2 is used here
+}
+
 TEST(Interfaces, TheMaterialIsTheFirstSlotWithANegativeDistance) {
   EXPECT_EQ(materialSlot({0.1, -0.2, -0.3, 0.4}, 4), 1);
   EXPECT_EQ(materialSlot({0.1, 0.2, -0.3, 0.4}, 2), -1);  // slot 2 is not in use

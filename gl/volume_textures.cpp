@@ -72,17 +72,22 @@ VolumeTextureLayout VolumeTextureLayout::plan(const std::vector<std::pair<std::s
     for (const auto& [name, components] : group.fields) {
       int have = componentsOf(name);
       if (have != 0) {
-        if (have != components) {
+        // The interfaces' distances may be uploaded for the used slots alone (their first channels).
+        const bool prefix = std::string_view(name) == "interfaces" && have < components;
+        if (have != components && !prefix) {
           throw RuntimeError("field " + std::string(name) + " has " + std::to_string(have) +
                              " components, expected " + std::to_string(components));
         }
-        slot.fields.push_back({name, static_cast<int>(layout.textures_.size()), channel, components});
-        channel += components;
+        slot.fields.push_back({name, static_cast<int>(layout.textures_.size()), channel, have});
+        channel += have;
         slot.channels = channel;
       }
     }
     if (slot.fields.empty()) continue;
-    if (padToRGBA) slot.channels = 4;
+    // Padded to RGBA; not a texture of one or two channels holding the used slots' distances
+    // (R32F and RG32F are native formats; RGB is what llvmpipe samples slowly).
+    const bool used_slots = slot.group == std::string_view("interfaces") && slot.channels < 3;
+    if (padToRGBA && !used_slots) slot.channels = 4;
     layout.textures_.push_back(std::move(slot));
   }
   for (const auto& [name, components] : fields) {
@@ -92,10 +97,13 @@ VolumeTextureLayout VolumeTextureLayout::plan(const std::vector<std::pair<std::s
 }
 
 VolumeTextureLayout VolumeTextureLayout::plan(const Volume& volume, bool padToRGBA,
-                                              const std::vector<std::string>& leave_out) {
+                                              const std::vector<std::string>& leave_out, int interface_slots) {
   std::vector<std::pair<std::string, int>> fields;
-  for (const auto& [name, field] : volume.fields)
-    if (std::find(leave_out.begin(), leave_out.end(), name) == leave_out.end()) fields.emplace_back(name, field.components);
+  for (const auto& [name, field] : volume.fields) {
+    if (std::find(leave_out.begin(), leave_out.end(), name) != leave_out.end()) continue;
+    const bool first_slots = name == "interfaces" && interface_slots > 0 && interface_slots < field.components;
+    fields.emplace_back(name, first_slots ? interface_slots : field.components);
+  }
   return plan(fields, padToRGBA);
 }
 
@@ -136,7 +144,8 @@ std::size_t defaultTextureBudget() {
 }
 
 VolumeTextures::VolumeTextures(const Volume& volume, const VolumeTextureOptions& options)
-    : layout_(VolumeTextureLayout::plan(volume, options.padToRGBA, options.leave_out)), dims_(volume.grid.dims) {
+    : layout_(VolumeTextureLayout::plan(volume, options.padToRGBA, options.leave_out, options.interface_slots)),
+      dims_(volume.grid.dims) {
   const GlContext& context = detail::requireContext("uploading a volume");
   const int limit = context.info().max3DTextureSize;
   if (dims_.x < 1 || dims_.y < 1 || dims_.z < 1) {
@@ -164,11 +173,11 @@ VolumeTextures::VolumeTextures(const Volume& volume, const VolumeTextureOptions&
   for (const VolumeTextureSlot& texture : layout_.textures()) {
     for (const VolumeFieldSlot& slot : texture.fields) {
       const Field& field = volume.fields.at(slot.field);
-      if (field.data.size() != voxels * static_cast<std::size_t>(slot.components)) {
+      if (field.data.size() != voxels * static_cast<std::size_t>(field.components)) {
         throw InputError(options.source, slot.field,
                          "has " + std::to_string(field.data.size()) + " values, expected " +
-                             std::to_string(voxels * static_cast<std::size_t>(slot.components)) + " for " +
-                             dimsText(dims_) + " voxels of " + std::to_string(slot.components) + " components");
+                             std::to_string(voxels * static_cast<std::size_t>(field.components)) + " for " +
+                             dimsText(dims_) + " voxels of " + std::to_string(field.components) + " components");
       }
     }
   }
@@ -177,7 +186,8 @@ VolumeTextures::VolumeTextures(const Volume& volume, const VolumeTextureOptions&
   for (const VolumeTextureSlot& texture : layout_.textures()) {
     const std::size_t channels = static_cast<std::size_t>(texture.channels);
     std::vector<float> packed;
-    if (texture.fields.size() == 1 && static_cast<std::size_t>(texture.fields[0].components) == channels) {
+    if (texture.fields.size() == 1 && static_cast<std::size_t>(texture.fields[0].components) == channels &&
+        volume.fields.at(texture.fields[0].field).components == texture.channels) {
       const Field& field = volume.fields.at(texture.fields[0].field);
       textures_.emplace_back(dims_, floatFormat(texture.channels, options.half), field.data, texture.channels,
                              options.sampling);
@@ -186,10 +196,11 @@ VolumeTextures::VolumeTextures(const Volume& volume, const VolumeTextureOptions&
     packed.assign(voxels * channels, 0.0f);
     for (const VolumeFieldSlot& slot : texture.fields) {
       const Field& field = volume.fields.at(slot.field);
-      const std::size_t components = static_cast<std::size_t>(slot.components);
+      const std::size_t components = static_cast<std::size_t>(slot.components);  // the first of the field's
+      const std::size_t stride = static_cast<std::size_t>(field.components);
       const std::size_t channel = static_cast<std::size_t>(slot.channel);
       for (std::size_t v = 0; v < voxels; ++v) {
-        const float* src = field.data.data() + v * components;
+        const float* src = field.data.data() + v * stride;
         float* dst = packed.data() + v * channels + channel;
         for (std::size_t c = 0; c < components; ++c) dst[c] = src[c];
       }

@@ -11,7 +11,8 @@
 //   light_dir   light_dir (rgb)
 //   opaque      opaque (rgba)
 //   reflect     reflect (rgba)
-//   interfaces  interfaces (rgba)                crossing sharp interfaces (core/interfaces.h)
+//   interfaces  interfaces (rgba; or the used slots' r, rg: VolumeTextureOptions::interface_slots)
+//                                                crossing sharp interfaces (core/interfaces.h)
 //
 // Groups with no field present are dropped and the rest numbered 0, 1, ...; within a group the
 // fields present take consecutive channels in the order above (ior_grad alone is rgb). Each
@@ -52,8 +53,9 @@ class VolumeTextureLayout {
   // The grouping above applied to the fields present (name, components); RuntimeError when a
   // known field has the wrong number of components.
   static VolumeTextureLayout plan(const std::vector<std::pair<std::string, int>>& fields, bool padToRGBA = false);
+  // `interface_slots` > 0: the interfaces field's first that many distances alone (the used slots').
   static VolumeTextureLayout plan(const Volume& volume, bool padToRGBA = false,
-                                  const std::vector<std::string>& leave_out = {});
+                                  const std::vector<std::string>& leave_out = {}, int interface_slots = 0);
 
   const std::vector<VolumeTextureSlot>& textures() const { return textures_; }
   int textureCount() const { return static_cast<int>(textures_.size()); }
@@ -88,6 +90,10 @@ struct VolumeTextureOptions {
   // Fields not uploaded (and not in the layout): what a shader takes elsewhere, e.g. the viewer's
   // σa where every material has one constant (MEDIUM_SIGMA_A).
   std::vector<std::string> leave_out;
+  // > 0: only the first this many of the interfaces' four distances are uploaded (the used slots';
+  // the shader fills in the others' constant, INTERFACES_UNUSED): one or two slots make an R32F or
+  // RG32F texture, a quarter or half of RGBA32F.
+  int interface_slots = 0;
 };
 
 // EIKONAL_GL_TEXTURE_BUDGET_MB, else 4096 MiB.

@@ -96,6 +96,25 @@ TEST(VolumeTextureLayoutTest, AFieldLeftOutIsNotUploaded) {
             "optics[4]: ior.r ior_grad.gba; absorption[1]: dispersion.r; ");
 }
 
+TEST(VolumeTextureLayoutTest, TheUsedSlotsDistancesAloneAreOneOrTwoChannels) {
+  Volume volume;
+  volume.grid.dims = {2, 2, 2};
+  volume.addField("ior", 1);
+  volume.addField("ior_grad", 3);
+  volume.addField("interfaces", 4);
+  // One used slot: an R texture, not padded to RGBA; its swizzle reads the first distance.
+  const VolumeTextureLayout one = VolumeTextureLayout::plan(volume, true, {"ior", "ior_grad"}, 1);
+  EXPECT_EQ(describe(one), "interfaces[1]: interfaces.r; ");
+  EXPECT_NE(one.glslDefines().find("#define INTERFACES_SWZ r\n"), std::string::npos);
+  EXPECT_EQ(describe(VolumeTextureLayout::plan(volume, true, {"ior", "ior_grad"}, 2)), "interfaces[2]: interfaces.rg; ");
+  // Three slots: RGB would be slow to sample, so RGBA as before; 0 or 4: the whole field.
+  EXPECT_EQ(describe(VolumeTextureLayout::plan(volume, true, {"ior", "ior_grad"}, 3)), "interfaces[4]: interfaces.rgb; ");
+  EXPECT_EQ(describe(VolumeTextureLayout::plan(volume, true, {"ior", "ior_grad"}, 0)), "interfaces[4]: interfaces.rgba; ");
+  EXPECT_EQ(describe(VolumeTextureLayout::plan(volume, true, {"ior", "ior_grad"}, 4)), "interfaces[4]: interfaces.rgba; ");
+  // Another field cannot be cut short.
+  EXPECT_THROW(VolumeTextureLayout::plan(Fields{{"sigma_a", 2}}), RuntimeError);
+}
+
 TEST(VolumeTextureLayoutTest, WrongComponentCountIsAnError) {
   EXPECT_THROW(VolumeTextureLayout::plan(Fields{{"ior_grad", 4}}), RuntimeError);
 }
@@ -126,10 +145,10 @@ class VolumeTexturesGl : public ::testing::Test {
 // field values (linear filtering at a centre returns the texel exactly).
 void probe(const Volume& volume, const VolumeTextures& textures, const std::string& expression,
            const std::vector<std::pair<std::string, int>>& expected /* field, component; "" = constant */,
-           const std::vector<float>& constants = {}) {
+           const std::vector<float>& constants = {}, const std::string& extra_defines = "") {
   ShaderLibrary library;
   Program program = library.program("common/fullscreen.vert", "test/volume_probe.frag", {{"PROBE(uvw)", expression}},
-                                    textures.layout().glslDefines());
+                                    textures.layout().glslDefines() + extra_defines);
   const glm::ivec3 dims = volume.grid.dims;
   Framebuffer target({dims.x * dims.z, dims.y}, {TextureFormat::RGBA32F});
   FullscreenTriangle triangle;
@@ -180,6 +199,21 @@ TEST_F(VolumeTexturesGl, UploadedFieldsSampleBackExactly) {
   probe(volume, textures, "volumeOpaque(uvw)", {{"opaque", 0}, {"opaque", 1}, {"opaque", 2}, {"opaque", 3}});
   probe(volume, textures, "volumeReflect(uvw) + vec4(0.0, 0.0, 0.0, volumeLightDir(uvw).x)",
         {{"", 0}, {"", 0}, {"", 0}, {"", 0}});
+}
+
+// The used slots' distances alone (VolumeTextureOptions::interface_slots): an RG32F texture of the
+// first two, the shader filling the others in with INTERFACES_UNUSED.
+TEST_F(VolumeTexturesGl, TheUsedSlotsDistancesAloneSampleBackWithTheUnusedConstant) {
+  Volume volume = makeVolume({5, 4, 3}, {{"interfaces", 4}}, 7);
+  VolumeTextureOptions options;
+  options.padToRGBA = true;
+  options.interface_slots = 2;
+  VolumeTextures textures(volume, options);
+  ASSERT_EQ(textures.textures().size(), 1u);
+  EXPECT_EQ(textures.texture(0).format(), TextureFormat::RG32F);
+  EXPECT_EQ(textures.bytes(), 60u * 8);
+  probe(volume, textures, "volumeInterfaces(uvw)", {{"interfaces", 0}, {"interfaces", 1}, {"", 0}, {"", 0}},
+        {0.0f, 0.0f, 0.25f, 0.25f}, "#define INTERFACES_UNUSED 0.25\n");
 }
 
 TEST_F(VolumeTexturesGl, RefractionOnlyVolumeAndHalfFloats) {

@@ -150,19 +150,9 @@ VolumeSampler::VolumeSampler(const Volume& volume)
   if (!table_.empty()) {
     d = &volume.require("interfaces", 4);
     const int used = slotCount();
-    unused_distance_ = used < 4 ? d->voxel(0)[used] : 0.0f;
-    std::vector<std::uint8_t> chunk_constant(static_cast<std::size_t>(chunks), 1);
-    forChunks([&](std::size_t begin, std::size_t end) {
-      bool constant = true;
-      for (std::size_t i = begin; i < end && constant; ++i) {
-        const float* v = d->voxel(i);
-        for (int k = used; k < 4; ++k) constant = constant && v[k] == unused_distance_;
-      }
-      chunk_constant[begin / static_cast<std::size_t>(kChunk)] = constant ? 1 : 0;
-    });
-    const bool unused_constant =
-        std::all_of(chunk_constant.begin(), chunk_constant.end(), [](std::uint8_t c) { return c != 0; });
-    if (unused_constant && used < 4) {
+    const std::optional<float> unused = unusedSlotDistance(*d, used);
+    unused_distance_ = unused.value_or(0.0f);
+    if (unused) {
       used_distances_.resize(n * static_cast<std::size_t>(used));
       forChunks([&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)

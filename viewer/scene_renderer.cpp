@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -205,10 +207,29 @@ struct SceneRenderer::Impl {
       o.defines += "#define SIGMA_A_BY_MATERIAL 1\n";
       if (!loaded.volume.has("dispersion")) options.leave_out.push_back("sigma_a");
     }
+    // Sharp materials of constant n (CONSTANT_SLOTS): n is the slot's and ∇n = 0 wherever a ray
+    // is, so the shader never samples the ior texture and it is not uploaded (at 132³ its RGBA32F
+    // texture and the staging copy are 2 × 37 MB that the kernel would zero).
+    const bool constant_slots = !table.empty() && std::none_of(table.slots.begin(), table.slots.end(),
+                                                               [](const InterfaceSlot& s) { return s.graded; });
+    if (constant_slots) {
+      options.leave_out.push_back("ior");
+      options.leave_out.push_back("ior_grad");
+    }
+    // One or two slots: their distances alone (R32F, RG32F; a quarter or half of the RGBA32F
+    // texture), the unused slots' one value a constant of the shader.
+    if (const int used = static_cast<int>(table.slots.size()); used > 0 && used < 3) {
+      if (const std::optional<float> unused = unusedSlotDistance(loaded.volume.require("interfaces", 4, loaded.source), used)) {
+        options.interface_slots = used;
+        char value[48];
+        std::snprintf(value, sizeof value, "%.9g", static_cast<double>(*unused));
+        o.defines += "#define INTERFACES_UNUSED " + std::string(value) + "\n";
+      }
+    }
     o.textures = gl::VolumeTextures(loaded.volume, options);
     const gl::VolumeFieldSlot* ior = o.textures.layout().find("ior");
     const gl::VolumeFieldSlot* grad = o.textures.layout().find("ior_grad");
-    if (!ior || !grad || ior->texture != grad->texture || ior->channel != 0 || grad->channel != 1)
+    if (!constant_slots && (!ior || !grad || ior->texture != grad->texture || ior->channel != 0 || grad->channel != 1))
       throw RuntimeError("viewer: expected ior and ior_grad together in one RGBA texture");
     if (scene.ground) attachReceiver(o, loaded, *scene.ground, prepared_texels);
     if (o.has_receiver) o.defines += "#define HAS_RECEIVER 1\n";
@@ -484,6 +505,12 @@ void SceneRenderer::replaceVolume(int index, const LoadedObject& object) {
 int SceneRenderer::objectCount() const { return static_cast<int>(impl_->objects.size()); }
 
 bool SceneRenderer::usesGroundMap() const { return impl_->has_ground_map; }
+
+std::size_t SceneRenderer::volumeTextureBytes() const {
+  std::size_t total = 0;
+  for (const auto& o : impl_->objects) total += o.textures.bytes();
+  return total;
+}
 
 namespace {
 // Whether the framebuffer bound for drawing has a depth buffer (the default framebuffer: taken as

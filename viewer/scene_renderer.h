@@ -66,6 +66,9 @@ class SceneRenderer {
   // Whether the ground is shaded from one ground map (viewer/ground_map.h: two or more objects
   // have a receiver map) rather than from each object's map.
   bool usesGroundMap() const;
+  // The GPU memory the objects' volume fields take (their 3D textures; not the receiver maps,
+  // bricks or environment).
+  std::size_t volumeTextureBytes() const;
   // Replaces object `index`'s volume (a fresh bake of it: viewer/background_bake.h) and uploads it;
   // recompiles the shader only when what selects its variant changed (its fields, interfaces,
   // receiver). Same errors as the constructor; std::out_of_range for a bad index.

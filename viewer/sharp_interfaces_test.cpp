@@ -102,6 +102,40 @@ TEST_F(SharpViewerTest, RaysThroughABallLeaveAsExactRefractionSays) {
   }
 }
 
+// A ball of constant n uploads its slot's distances alone, one float a voxel (R32F): no n or ∇n
+// (the shader takes the slot's n, CONSTANT_SLOTS) and not the three unused slots' +band
+// (INTERFACES_UNUSED). The picture — radiance and exit directions — is the one of the whole RGBA
+// interfaces texture to the bit: the same march, read from less memory.
+TEST_F(SharpViewerTest, AVolumeOfConstantNUploadsItsUsedDistancesAlone) {
+  const Volume lean = sharpVolume("procedural:sphere,r=0.5,ior=1.5", 48, box({-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6}));
+  // The same with one unused distance off the format's +band (a hand-made file): the unused slots
+  // are no longer one constant, so all four distances are uploaded.
+  Volume whole = lean;
+  Field& d = whole.fields.at("interfaces");
+  d.voxel(0)[3] *= 2.0f;  // a corner voxel, far from the ball: the march never reads it
+  const std::size_t voxels = lean.grid.count();
+  const Camera camera = lookAlong({0.3, 0.4, 2.0}, glm::normalize(glm::dvec3(-0.3, -0.4, -2.0)), 30.0);
+  for (RenderOutput output : {RenderOutput::Radiance, RenderOutput::ExitDirection}) {
+    RenderSettings settings;
+    settings.output = output;
+    SceneRenderer lean_renderer(*shaders_, oneObject(lean), settings);
+    SceneRenderer whole_renderer(*shaders_, oneObject(whole), settings);
+    // Leaving n and ∇n in (or uploading all four distances) fails these.
+    EXPECT_EQ(lean_renderer.volumeTextureBytes(), voxels * sizeof(float));
+    EXPECT_EQ(whole_renderer.volumeTextureBytes(), voxels * 4 * sizeof(float));
+    const Image a = lean_renderer.render(camera, {40, 40});
+    const Image b = whole_renderer.render(camera, {40, 40});
+    ASSERT_EQ(a.pixels.size(), b.pixels.size());
+    int differing = 0, lit = 0;
+    for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+      differing += a.pixels[i] != b.pixels[i] ? 1 : 0;
+      lit += a.pixels[i] != 0.0f ? 1 : 0;
+    }
+    EXPECT_EQ(differing, 0) << "output " << static_cast<int>(output);
+    EXPECT_GT(lit, 400);  // the ball and the sky are there
+  }
+}
+
 // Between sharp surfaces of constant n the march steps as far as the distance field allows
 // (object.glsl stepLength@, on with empty-space skipping). A rounded cube of three absorbing glasses
 // (n 1.45, 1.55, 1.65; refraction, total internal reflection, Fresnel, Beer–Lambert) gives the same

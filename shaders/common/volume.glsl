@@ -122,7 +122,12 @@ vec4 volumeReflect(vec3 uvw) {
 
 // The signed distances of the interface slots (core/interfaces.h): negative inside; +band far out.
 vec4 volumeInterfaces(vec3 uvw) {
-#ifdef HAS_INTERFACES
+#if defined(HAS_INTERFACES) && defined(INTERFACES_UNUSED)
+  // The used slots' distances alone were uploaded (R or RG): the others read their one constant.
+  vec4 d = vec4(INTERFACES_UNUSED);
+  d.INTERFACES_SWZ = texture(INTERFACES_SAMPLER, uvw).INTERFACES_SWZ;
+  return d;
+#elif defined(HAS_INTERFACES)
   return texture(INTERFACES_SAMPLER, uvw).INTERFACES_SWZ;
 #else
   return vec4(1e30);

@@ -140,11 +140,14 @@ vec4 refractiveIndex@(vec3 uvw, float cauchy, int medium) {
   float slotN = medium < 0 ? 1.0 : SLOT_IOR[max(medium, 0)];
 #endif
 #ifdef CONSTANT_SLOTS
-  return vec4(slotN, 0.0, 0.0, 0.0);  // no graded slot: no fetch (llvmpipe would fetch, masked)
+  // No graded slot: no fetch (llvmpipe would fetch, masked), and no ior texture (SceneRenderer
+  // leaves it out).
+  return vec4(slotN, 0.0, 0.0, 0.0);
 #else
   if (medium < 0 || SLOT_GRADED[medium] < 0.5) return vec4(slotN, 0.0, 0.0, 0.0);
 #endif
 #endif
+#ifndef CONSTANT_SLOTS
   vec4 optics = texture(IOR_SAMPLER, uvw);  // ior (r), ior_grad (gba)
 #if defined(DISPERSION) && defined(HAS_DISPERSION)
   float B = volumeDispersion(uvw);
@@ -155,6 +158,7 @@ vec4 refractiveIndex@(vec3 uvw, float cauchy, int medium) {
   optics.gba = vec3(0.0);
 #endif
   return optics;
+#endif
 }
 
 // δ·R·L_r and the transmission factor (Eq. 5.4 in Eq. 5.10, docs/physics.md; FRESNEL), once the
