@@ -638,6 +638,16 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   std::vector<std::vector<std::uint32_t>> band_lists;  // …and those whose footprint reaches each band of map rows
   std::vector<Patch> next;
   std::vector<PatchSamples> next_samples;
+  // Room for many times the initial patches in each per-patch array: address space costs nothing
+  // until a page is touched, and the arrays then neither move nor touch fresh memory (which the
+  // kernel zeroes, 2 MiB at a time) each time the wavefront outgrows them.
+  const std::size_t capacity = std::max<std::size_t>(8 * patches.size(), std::size_t(1) << 16);
+  patches.reserve(capacity);
+  samples.reserve(capacity);
+  next.reserve(capacity);
+  next_samples.reserve(capacity);
+  results.reserve(capacity);
+  offsets.reserve(capacity + 1);
   double t_update = 0.0, t_deposit = 0.0, t_compact = 0.0;
   const double total_in = luminance(stats.flux_in);
 

@@ -126,11 +126,13 @@ std::vector<float> shadowClearance(const Volume& volume, const ReceiverMap& map,
     }
     return best;
   };
-  // Coarse to fine: c at every kBlock-th texel first; a block whose four corners have one sign and
-  // |c| over the block's edge keeps that sign throughout (c changes by at most the distance moved:
-  // the distance field is 1-Lipschitz, so is its least value along a shifted ray) and gets the
-  // corners' bilinear c (only its sign is read there); the blocks the edge may cross are marched
-  // texel by texel.
+  // Coarse to fine: c at every kBlock-th texel first, then each block refined as a quadtree. A
+  // block whose four corners have one sign and |c| over half its diagonal (with a margin) keeps
+  // that sign throughout (c changes by at most the distance moved: the distance field is
+  // 1-Lipschitz, so is its least value along a shifted ray) and gets the corners' bilinear c (only
+  // its sign is read there); the others are split in four (c marched at their five new points)
+  // down to 2×2 texels, which are marched texel by texel. The margin of two texels keeps every texel
+  // next to the edge, whose c the shader interpolates across it, marched.
   constexpr int kBlock = 8;
   const int nx = map.texels.x, ny = map.texels.y;
   const int bx = (nx + kBlock - 1) / kBlock, by = (ny + kBlock - 1) / kBlock;
@@ -143,35 +145,48 @@ std::vector<float> shadowClearance(const Volume& volume, const ReceiverMap& map,
               march(std::min(ci * kBlock, nx - 1), std::min(static_cast<int>(cj) * kBlock, ny - 1));
       },
       4);
-  // Every texel of a block lies within half the block's diagonal of a corner (and the band, where
-  // c is clamped, is 16 texels of the default pitch).
-  const double sure = 0.75 * kBlock * map.pitch;
   std::vector<float> clearance(map.texelCount(), static_cast<float>(band));
+  auto put = [&](int i, int j, double c) {
+    clearance[static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i)] = static_cast<float>(c);
+  };
+  // The block of texels [i0, i0 + size) × [j0, j0 + size) within the map, its corners' c at the
+  // texels (i0, j0), (i1, j0), (i0, j1), (i1, j1) with i1 = min(i0 + size, nx − 1) (the next
+  // block's first texel, or the map's last).
+  auto refine = [&](auto&& self, int i0, int j0, int size, double c00, double c10, double c01, double c11) -> void {
+    const int i1 = std::min(i0 + size, nx - 1), j1 = std::min(j0 + size, ny - 1);
+    const int iend = std::min(i0 + size, nx), jend = std::min(j0 + size, ny);
+    // Every texel of the block lies within half its diagonal of a corner (0.75 > √2/2).
+    const double sure = (0.75 * size + 2.0) * map.pitch;
+    const bool lit = c00 > sure && c10 > sure && c01 > sure && c11 > sure;
+    const bool dark = c00 < -sure && c10 < -sure && c01 < -sure && c11 < -sure;
+    if (lit || dark) {
+      for (int j = j0; j < jend; ++j)
+        for (int i = i0; i < iend; ++i) {
+          const double fx = i1 > i0 ? double(i - i0) / (i1 - i0) : 0.0, fy = j1 > j0 ? double(j - j0) / (j1 - j0) : 0.0;
+          put(i, j, (1 - fx) * (1 - fy) * c00 + fx * (1 - fy) * c10 + (1 - fx) * fy * c01 + fx * fy * c11);
+        }
+      return;
+    }
+    const int half = size / 2;
+    if (size <= 2 || i0 + size > nx - 1 || j0 + size > ny - 1) {  // small, or at the map's far side
+      for (int j = j0; j < jend; ++j)
+        for (int i = i0; i < iend; ++i) put(i, j, march(i, j));
+      return;
+    }
+    const int im = i0 + half, jm = j0 + half;
+    const double cm0 = march(im, j0), c0m = march(i0, jm), cmm = march(im, jm), c1m = march(i1, jm), cm1 = march(im, j1);
+    self(self, i0, j0, half, c00, cm0, c0m, cmm);
+    self(self, im, j0, half, cm0, c10, cmm, c1m);
+    self(self, i0, jm, half, c0m, cmm, c01, cm1);
+    self(self, im, jm, half, cmm, c1m, cm1, c11);
+  };
   parallelFor(
       0, static_cast<std::int64_t>(bx) * by,
       [&](std::int64_t b) {
         const int bi = static_cast<int>(b % bx), bj = static_cast<int>(b / bx);
         const double* row0 = &coarse[static_cast<std::size_t>(bj) * static_cast<std::size_t>(bx + 1)];
         const double* row1 = row0 + (bx + 1);
-        const double c00 = row0[bi], c10 = row0[bi + 1], c01 = row1[bi], c11 = row1[bi + 1];
-        const bool lit = c00 > sure && c10 > sure && c01 > sure && c11 > sure;
-        const bool dark = c00 < -sure && c10 < -sure && c01 < -sure && c11 < -sure;
-        // The corners' texels: the next block's first texel, or the last texel of the map.
-        const int i0 = bi * kBlock, j0 = bj * kBlock;
-        const int i1 = std::min(i0 + kBlock, nx - 1), j1 = std::min(j0 + kBlock, ny - 1);
-        for (int j = j0; j < std::min(j0 + kBlock, ny); ++j) {
-          for (int i = i0; i < std::min(i0 + kBlock, nx); ++i) {
-            double c = 0.0;
-            if (lit || dark) {
-              const double fx = i1 > i0 ? double(i - i0) / (i1 - i0) : 0.0, fy = j1 > j0 ? double(j - j0) / (j1 - j0) : 0.0;
-              c = (1 - fx) * (1 - fy) * c00 + fx * (1 - fy) * c10 + (1 - fx) * fy * c01 + fx * fy * c11;
-            } else {
-              c = march(i, j);
-            }
-            clearance[static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i)] =
-                static_cast<float>(c);
-          }
-        }
+        refine(refine, bi * kBlock, bj * kBlock, kBlock, row0[bi], row0[bi + 1], row1[bi], row1[bi + 1]);
       },
       4);
   return clearance;
