@@ -22,6 +22,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -607,8 +608,8 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   double flux_ref = 0.0;
   DirectCells direct;  // cells that go straight to the receiver's map: in closed form, not followed
   std::vector<Patch> patches = initialPatches(light, grid, sampler_, options, &flux_ref, ctx.receiver, &direct);
-  std::vector<glm::dvec3> direct_flux;
-  if (direct.cells > 0) direct_flux = directMapLight(receiver, light, patches);
+  std::optional<DirectMapLight> direct_light;
+  if (direct.cells > 0) direct_light = directMapLight(receiver, light, patches);
   adjustInitialPatches(patches, sampler_, options, flux_ref);
   ctx.flux_ref = flux_ref;
   ctx.dim_irradiance = kDimTrackFraction * brightestIrradiance(light, grid);
@@ -846,7 +847,8 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   }
   if (options.receiver) {
     // Planar irradiance: each texel's flux over its area.
-    receiver_flux->irradiance(direct_flux, 1.0 / (receiver.pitch * receiver.pitch), receiver.irradiance);
+    receiver_flux->irradiance(direct_light ? &*direct_light : nullptr, 1.0 / (receiver.pitch * receiver.pitch),
+                              receiver.irradiance);
     bake.receivers.push_back(std::move(receiver));
   }
   stats.phase_seconds["update"] = t_update;

@@ -302,7 +302,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   std::vector<Patch> initial = initialPatches(light, grid, sampler, options, &fluxRef,
                                               options.receiver ? &receiver : nullptr, &direct);
   std::vector<glm::dvec3> directFlux;
-  if (direct.cells > 0) directFlux = directMapLight(receiver, light, initial);
+  if (direct.cells > 0) directFlux = directMapLight(receiver, light, initial).texels();
   adjustInitialPatches(initial, sampler, options, fluxRef);
   stats.initial_patches = initial.size();
   for (const Patch& p : initial) stats.flux_in += p.flux;

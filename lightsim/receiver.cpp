@@ -189,14 +189,21 @@ void depositConvex(const ReceiverMap& map, const glm::dvec2* polygon, int count,
 
 }  // namespace
 
-std::vector<glm::dvec3> directMapLight(const ReceiverMap& map, const LightSpec& light,
-                                       const std::vector<Patch>& followed) {
+DirectMapLight directMapLight(const ReceiverMap& map, const LightSpec& light, const std::vector<Patch>& followed) {
   const bool point = light.type != LightSpec::Type::Directional;  // a point or a spot light
   const glm::dvec3 L = point ? glm::dvec3(0.0) : glm::normalize(light.direction);
   // |L·n| for a directional light that reaches the front; a point light's height over the plane.
   const double facing = point ? glm::dot(light.position - map.point, map.normal) : -glm::dot(L, map.normal);
   if (!(facing > 0.0))
     throw InputError("receiver", "light", "direct light on the map needs a light that reaches its front");
+  DirectMapLight direct;
+  direct.map_ = map;
+  direct.map_.irradiance.clear();
+  direct.point_ = point;
+  direct.light_ = light;
+  // The light's flux over each texel: a point light's I·cos θ/d² = I·h/d³ at the texel's centre,
+  // times its area (the texel's mean to (pitch/d)², under 10⁻⁴ at a quarter voxel's pitch).
+  direct.full_ = light.power * (facing * map.pitch * map.pitch);
   const std::size_t count = followed.size();
   std::vector<std::array<glm::dvec2, 4>> footprints(count);
   std::vector<std::uint8_t> lands(count, 0);
@@ -208,41 +215,44 @@ std::vector<glm::dvec3> directMapLight(const ReceiverMap& map, const LightSpec& 
       },
       1024);
   // What the followed patches would put on the map going straight, by bands of texel rows in
-  // parallel (each band adds the patches in order: the sums do not depend on the thread count).
-  std::vector<glm::dvec3> flux(map.texelCount(), glm::dvec3(0.0));
-  constexpr int kRows = FootprintSums::kBandRows;
+  // parallel (each band adds the patches in order: the sums do not depend on the thread count); a
+  // band is made at the first footprint that reaches it. The light's flux over a texel less
+  // theirs is its direct light (≥ 0: the two agree to rounding where the patches cover the texel
+  // wholly): DirectMapLight::flux.
+  constexpr int kRows = DirectMapLight::kRows;
+  static_assert(kRows == FootprintSums::kBandRows);
   const int bands = (map.texels.y + kRows - 1) / kRows;
+  direct.followed_.resize(static_cast<std::size_t>(bands));
   parallelFor(0, bands, [&](std::int64_t band) {
     const int r0 = static_cast<int>(band) * kRows, r1 = r0 + kRows;
     const double y0 = map.origin.y + r0 * map.pitch, y1 = map.origin.y + r1 * map.pitch;
+    std::vector<glm::dvec3>& sums = direct.followed_[static_cast<std::size_t>(band)];
     for (std::size_t k = 0; k < count; ++k) {
       if (!lands[k]) continue;
       const std::array<glm::dvec2, 4>& f = footprints[k];
       const double lo = std::min(std::min(f[0].y, f[1].y), std::min(f[2].y, f[3].y));
       const double hi = std::max(std::max(f[0].y, f[1].y), std::max(f[2].y, f[3].y));
       if (hi < y0 || lo > y1) continue;
-      depositFootprint(map, f, followed[k].flux, flux, r0, r1);
+      if (sums.empty()) sums.assign(static_cast<std::size_t>(kRows) * static_cast<std::size_t>(map.texels.x), glm::dvec3(0.0));
+      depositFootprint(map, f, followed[k].flux,
+                       TexelRows{sums.data(), map.texels.x, r0, r0, std::min(r1, map.texels.y)});
     }
   });
-  // The light's flux over each texel less theirs (≥ 0: the two agree to rounding where the patches
-  // cover the texel wholly). A point light's: I·cos θ/d² = I·h/d³ at the texel's centre, times its
-  // area (the texel's mean to (pitch/d)², under 10⁻⁴ at a quarter voxel's pitch).
-  const glm::dvec3 full = light.power * (facing * map.pitch * map.pitch);
-  parallelFor(
-      0, static_cast<std::int64_t>(flux.size()),
-      [&](std::int64_t t) {
-        glm::dvec3& f = flux[static_cast<std::size_t>(t)];
-        if (!point) {
-          f = glm::max(full - f, glm::dvec3(0.0));
-          return;
-        }
-        const int i = static_cast<int>(t % map.texels.x), j = static_cast<int>(t / map.texels.x);
-        const glm::dvec3 to_texel = map.texelCenter(i, j) - light.position;
-        const double d = glm::length(to_texel);
-        f = glm::max(full * (light.attenuation(to_texel / d) / (d * d * d)) - f, glm::dvec3(0.0));
-      },
-      4096);
-  return flux;
+  return direct;
+}
+
+std::vector<glm::dvec3> DirectMapLight::texels() const {
+  std::vector<glm::dvec3> out(map_.texelCount());
+  parallelFor(0, map_.texels.y, [&](std::int64_t j) {
+    for (int i = 0; i < map_.texels.x; ++i)
+      out[static_cast<std::size_t>(j) * static_cast<std::size_t>(map_.texels.x) + static_cast<std::size_t>(i)] =
+          flux(i, static_cast<int>(j));
+  });
+  return out;
+}
+
+int DirectMapLight::heldBands() const {
+  return static_cast<int>(std::count_if(followed_.begin(), followed_.end(), [](const auto& b) { return !b.empty(); }));
 }
 
 FootprintSums::FootprintSums(const ReceiverMap& map) : map_(map) {
@@ -317,7 +327,7 @@ std::vector<glm::dvec3> FootprintSums::resolve() const {
   return out;
 }
 
-void FootprintSums::irradiance(const std::vector<glm::dvec3>& extra, double inv_area, std::vector<float>& out) const {
+void FootprintSums::irradiance(const DirectMapLight* extra, double inv_area, std::vector<float>& out) const {
   out.resize(map_.texelCount() * 3);
   parallelFor(
       0, map_.texels.y,
@@ -325,11 +335,10 @@ void FootprintSums::irradiance(const std::vector<glm::dvec3>& extra, double inv_
         const int j = static_cast<int>(j64);
         const RowSums sums = rowSums(j);
         const std::size_t first = static_cast<std::size_t>(j) * static_cast<std::size_t>(map_.texels.x);
-        const glm::dvec3* direct = first < extra.size() ? extra.data() + first : nullptr;
         float* row = out.data() + 3 * first;
         for (int i = 0; i < map_.texels.x; ++i) {
           glm::dvec3 flux = sums.flux(i);
-          if (direct) flux += direct[i];
+          if (extra) flux += extra->flux(i, j);
           for (int c = 0; c < 3; ++c) row[3 * i + c] = static_cast<float>(flux[c] * inv_area);
         }
       },

@@ -76,8 +76,42 @@ void depositFootprint(const ReceiverMap& map, const std::array<glm::dvec2, 4>& f
 // that meet the map and not the box, left out of the list (initialPatches with DirectCells),
 // tile the rest of every texel, so the map gets what their footprints would give it, to rounding.
 // Throws InputError naming "receiver" when the light does not reach the plane's front.
-std::vector<glm::dvec3> directMapLight(const ReceiverMap& map, const LightSpec& light,
-                                       const std::vector<Patch>& followed);
+// Held by bands of FootprintSums::kBandRows texel rows: the bands no followed footprint reaches
+// (most of a map) hold nothing, their texels' light is the closed form's (a 1024² map: 25 MB that
+// were written and read, and zeroed by the kernel first, now kept for the shadow's bands alone).
+class DirectMapLight {
+ public:
+  // W on texel (i, j).
+  glm::dvec3 flux(int i, int j) const {
+    const glm::dvec3 full = closedForm(i, j);
+    const std::vector<glm::dvec3>& band = followed_[static_cast<std::size_t>(j / kRows)];
+    if (band.empty()) return full;
+    return glm::max(full - band[static_cast<std::size_t>(j % kRows) * static_cast<std::size_t>(map_.texels.x) +
+                                static_cast<std::size_t>(i)],
+                    glm::dvec3(0.0));
+  }
+  // Every texel's, u fastest (the GPU path's receiver pass).
+  std::vector<glm::dvec3> texels() const;
+  // Bands of rows that hold the followed patches' light (the rest: the closed form alone).
+  int heldBands() const;
+
+ private:
+  friend DirectMapLight directMapLight(const ReceiverMap&, const LightSpec&, const std::vector<Patch>&);
+  static constexpr int kRows = 16;  // FootprintSums::kBandRows
+  // The light's flux over texel (i, j): E_L·|L·n|·pitch², or a point light's I·a(θ)·cos θ/d²·pitch².
+  glm::dvec3 closedForm(int i, int j) const {
+    if (!point_) return full_;
+    const glm::dvec3 to_texel = map_.texelCenter(i, j) - light_.position;
+    const double d = glm::length(to_texel);
+    return full_ * (light_.attenuation(to_texel / d) / (d * d * d));
+  }
+  ReceiverMap map_;  // the geometry (no irradiance)
+  bool point_ = false;
+  LightSpec light_;
+  glm::dvec3 full_{0.0};
+  std::vector<std::vector<glm::dvec3>> followed_;  // per band: the followed patches' straight flux, or none
+};
+DirectMapLight directMapLight(const ReceiverMap& map, const LightSpec& light, const std::vector<Patch>& followed);
 
 // The per-texel flux sums of a map being baked (the CPU twin's), with coarser levels for wide
 // footprints. A footprint whose box covers more than kFineFootprintTexels texels (dim light spread
@@ -106,9 +140,9 @@ class FootprintSums {
   // rvalue form hands over the fine level's storage instead of copying it (a 1024² map: 25 MB).
   std::vector<glm::dvec3> resolve() const;
   // The map's irradiance (3 floats a texel): each texel's flux as resolve() gives it, plus
-  // `extra[t]` where extra holds it (directMapLight's), times inv_area — without a whole map of
+  // `extra`'s (directMapLight's; none: nothing), times inv_area — without a whole map of
   // sums: the bands nothing landed in hold none.
-  void irradiance(const std::vector<glm::dvec3>& extra, double inv_area, std::vector<float>& out) const;
+  void irradiance(const DirectMapLight* extra, double inv_area, std::vector<float>& out) const;
 
  private:
   // Row j's sums on every level (null where the band holds none), and texel i's flux from them.

@@ -239,7 +239,15 @@ TEST(Receiver, TheDirectLightIsWhatTheLeftOutCellsWouldPutOnTheMap) {
   ASSERT_GT(direct.cells, 0u);
   EXPECT_EQ(followed.size() + direct.cells, all.size());
   EXPECT_LT(followed.size(), all.size() / 2);  // most of the map is lit directly
-  std::vector<glm::dvec3> flux = directMapLight(map, light, followed);
+  const DirectMapLight direct_light = directMapLight(map, light, followed);
+  std::vector<glm::dvec3> flux = direct_light.texels();
+  // The bands of rows the followed patches reach hold their light, the others nothing (most of the
+  // map: the box's shadow is a small part of it).
+  EXPECT_GT(direct_light.heldBands(), 0);
+  EXPECT_LT(direct_light.heldBands(), (map.texels.y + 15) / 16);
+  for (int j = 0; j < map.texels.y; j += 7)
+    for (int i = 0; i < map.texels.x; i += 5)
+      ASSERT_EQ(direct_light.flux(i, j), flux[static_cast<std::size_t>(j) * static_cast<std::size_t>(map.texels.x) + static_cast<std::size_t>(i)]);
   const glm::dvec3 texel_full = reference[0];  // a corner texel, far from the shadow: lit wholly
   int partial = 0, dark = 0;
   for (std::size_t t = 0; t < flux.size(); ++t) {
@@ -268,7 +276,7 @@ TEST(Receiver, TheDirectLightIsWhatTheLeftOutCellsWouldPutOnTheMap) {
   const std::vector<Patch> point_followed = initialPatches(point, volume.grid, sampler, options, nullptr, &point_map, &left);
   EXPECT_GT(left.cells, 0u);
   EXPECT_GT(point_followed.size(), 0u);
-  EXPECT_EQ(directMapLight(point_map, point, point_followed).size(), point_map.texelCount());
+  EXPECT_EQ(directMapLight(point_map, point, point_followed).texels().size(), point_map.texelCount());
   LightSpec below = point;
   below.position.y = spec.point.y - 1.0;
   EXPECT_THROW(directMapLight(point_map, below, {}), InputError);

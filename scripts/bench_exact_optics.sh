@@ -33,6 +33,10 @@
 #   --pov-counts "N..."  POV-Ray's photon counts (default "100000 200000 400000 1600000"), e.g. to
 #                  find the fewest photons at a given error
 #   --exact FILE   the exact tracer's JSON of an earlier run instead of tracing again
+#   --rounds R     then R rounds, alternated, of the whole pipeline (voxelize + bake + render at the
+#                  first --res) and POV-Ray at the first photon count, one after the other in each
+#                  round: both feel the machine's load alike. Prints their medians, the ratio of the
+#                  medians and the spread of the per-round ratios (OUT/rounds.md)
 # Needs the benchmark tool: cmake --build build --target ring_compare (EIKONAL_BUILD_BENCHMARKS and
 # EIKONAL_BUILD_TESTS on). Installs the Debian package povray when `povray` is missing (as root).
 # Prints the Markdown table on stdout (also OUT/table.md); progress goes to stderr.
@@ -40,7 +44,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build="$root/build"
 out=""
-quick=0 res_option="" backend=auto pov=1 exact_file="" pov_option=""
+quick=0 res_option="" backend=auto pov=1 exact_file="" pov_option="" rounds=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --out) out=$2; shift 2 ;;
@@ -51,6 +55,7 @@ while [ $# -gt 0 ]; do
     --no-pov) pov=0; shift ;;
     --pov-counts) pov_option=$2; shift 2 ;;
     --exact) exact_file=$(cd "$(dirname "$2")" && pwd)/$(basename "$2"); shift 2 ;;
+    --rounds) rounds=$2; shift 2 ;;
     -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
     *) echo "bench_exact_optics.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
   esac
@@ -233,3 +238,49 @@ cpu=$(awk -F': ' '/model name/ { print $2; exit }' /proc/cpuinfo)
   echo
   "$ring_compare" compare "${results[@]}"
 } | tee "$out/table.md"
+
+# --- 5. rounds: the pipeline against POV-Ray, alternated --------------------------------------------
+# Each round runs the three commands a user types (a fresh voxelization, bake and render of the
+# first resolution) and then POV-Ray at the first photon count; the two share the round's load, so
+# the per-round ratio is steadier than the ratio of two separate medians on a shared machine.
+if [ "$rounds" -gt 0 ] && [ "$pov" = 1 ]; then
+  res=${resolutions%% *} count=${pov_counts%% *} name="rounds"
+  run_log="$out/logs/rounds.log"
+  : >"$run_log"
+  [ -f "$out/pov_$count.pov" ] || pov_scene "$count" >"$out/pov_$count.pov"
+  view_scene "$name.baked.vol.json" >"$out/$name.view.json"
+  ms() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.0f", (b - a) * 1000 }'; }
+  {
+    echo "Rounds: Eikonal ${res}³ (voxelize + bake + render ${width}x$height) and POV-Ray ($count photons), alternated; wall ms."
+    echo
+    echo "| round | voxelize | bake | render | Eikonal | POV-Ray | ratio |"
+    echo "| ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+  } >"$out/rounds.md"
+  eik_all=() pov_all=() ratios=()
+  for r in $(seq "$rounds"); do
+    log "round $r of $rounds"
+    t0=$(now)
+    "$voxelize" procedural:sphere,r=1,center=0:1.5:0,ior=1.5 -o "$out/$name.vol.json" --res "$res" --pad 2 \
+      --interfaces sharp -q >>"$run_log" 2>&1
+    t1=$(now)
+    "$lightsim" "$out/$name.vol.json" -o "$out/$name.baked.vol.json" --scene "$out/bake_scene.json" \
+      --backend "$backend" -q >>"$run_log" 2>&1
+    t2=$(now)
+    "$viewer" "$out/$name.view.json" --render "$out/$name.floor.exr" --size "${width}x$height" -q >>"$run_log" 2>&1
+    t3=$(now)
+    (cd "$out" && povray "+Ipov_$count.pov" "+Orounds_pov.exr" +FE "+W$width" "+H$height" -D +WT2 -P >>"$run_log" 2>&1)
+    t4=$(now)
+    e=$(ms "$t0" "$t3") p=$(ms "$t3" "$t4")
+    eik_all+=("$e") pov_all+=("$p") ratios+=("$(awk -v p="$p" -v e="$e" 'BEGIN { printf "%.2f", p / e }')")
+    echo "| $r | $(ms "$t0" "$t1") | $(ms "$t1" "$t2") | $(ms "$t2" "$t3") | $e | $p | ${ratios[-1]} |" >>"$out/rounds.md"
+  done
+  e_med=$(median "${eik_all[@]}") p_med=$(median "${pov_all[@]}")
+  {
+    echo
+    echo "Medians: Eikonal $e_med ms, POV-Ray $p_med ms: POV-Ray takes $(awk -v p="$p_med" -v e="$e_med" 'BEGIN { printf "%.2f", p / e }')×" \
+      "as long; per-round ratios: median $(median "${ratios[@]}"), lowest $(printf '%s\n' "${ratios[@]}" | sort -g | head -1)," \
+      "highest $(printf '%s\n' "${ratios[@]}" | sort -g | tail -1)."
+  } >>"$out/rounds.md"
+  echo
+  cat "$out/rounds.md"
+fi
