@@ -166,8 +166,10 @@ struct SceneRenderer::Impl {
     return receiverTexels(layer, clearance);
   }
 
+  // `for_ground_map`: keep the map's irradiance, which only a ground map of two or more objects' maps
+  // reads (buildGroundMap); a lone object's is uploaded as its texels and not kept twice.
   static void attachReceiver(Object& o, const LoadedObject& loaded, const SceneGroundSpec& ground,
-                             const std::vector<float>* prepared) {
+                             const std::vector<float>* prepared, bool for_ground_map) {
     const GroundReceiver found = findGroundReceiver(loaded, ground);
     if (!found.map) return;
     o.receiver_light_pos = found.light_pos;
@@ -176,6 +178,7 @@ struct SceneRenderer::Impl {
     o.receiver_light_spot_scale = found.light_spot_scale;
     o.receiver_other_lights = found.other_lights;
     o.receiver = *found.map;  // with its irradiance, for the ground map
+    if (!for_ground_map) o.receiver.irradiance = {};
     o.receiver_texture = gl::Texture2D(found.map->texels, gl::TextureFormat::RGBA32F,
                                        prepared ? *prepared : groundTexels(loaded, found), 4);
     o.has_receiver = true;
@@ -231,7 +234,7 @@ struct SceneRenderer::Impl {
     const gl::VolumeFieldSlot* grad = o.textures.layout().find("ior_grad");
     if (!constant_slots && (!ior || !grad || ior->texture != grad->texture || ior->channel != 0 || grad->channel != 1))
       throw RuntimeError("viewer: expected ior and ior_grad together in one RGBA texture");
-    if (scene.ground) attachReceiver(o, loaded, *scene.ground, prepared_texels);
+    if (scene.ground) attachReceiver(o, loaded, *scene.ground, prepared_texels, scene.objects.size() > 1);
     if (o.has_receiver) o.defines += "#define HAS_RECEIVER 1\n";
     const std::vector<float> bricks = homogeneousBricks(loaded.volume, o.brick_dims);
     o.bricks = gl::Texture3D(o.brick_dims, gl::TextureFormat::R32F, bricks, 1, gl::Sampling{gl::Filter::Nearest});
