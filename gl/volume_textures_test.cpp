@@ -99,9 +99,7 @@ TEST(VolumeTextureLayoutTest, AFieldLeftOutIsNotUploaded) {
 TEST(VolumeTextureLayoutTest, TheUsedSlotsDistancesAloneAreOneOrTwoChannels) {
   Volume volume;
   volume.grid.dims = {2, 2, 2};
-  volume.addField("ior", 1);
-  volume.addField("ior_grad", 3);
-  volume.addField("interfaces", 4);
+  for (const auto& [name, components] : Fields{{"ior", 1}, {"ior_grad", 3}, {"interfaces", 4}}) volume.addField(name, components);
   // One used slot: an R texture, not padded to RGBA; its swizzle reads the first distance.
   const VolumeTextureLayout one = VolumeTextureLayout::plan(volume, true, {"ior", "ior_grad"}, 1);
   EXPECT_EQ(describe(one), "interfaces[1]: interfaces.r; ");
