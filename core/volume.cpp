@@ -180,7 +180,7 @@ class ManifestReader {
  public:
   explicit ManifestReader(const fs::path& manifest) : manifest_(manifest), name_(manifest.string()) {}
 
-  Volume read(bool with_data) {
+  Volume read(bool with_data, const std::vector<std::string>& leave_unread = {}) {
     nlohmann::json root = parse();
     Volume volume;
     checkFormat(root);
@@ -224,12 +224,16 @@ class ManifestReader {
 
     // The fields' data, one file a thread (each file's gzip stream decompresses on its own); the
     // first failing field in manifest order is the one reported.
+    auto unread = [&](const std::string& field) {
+      return std::find(leave_unread.begin(), leave_unread.end(), field) != leave_unread.end();
+    };
     std::vector<std::vector<float>> data(with_data ? entries.size() : 0);
     std::vector<std::exception_ptr> errors(data.size());
     parallelFor(
         0, static_cast<std::int64_t>(data.size()),
         [&](std::int64_t i) {
           const std::size_t k = static_cast<std::size_t>(i);
+          if (unread(entries[k].name)) return;
           try {
             data[k] = readNrrd(entries[k].file).data;
           } catch (...) {
@@ -238,6 +242,11 @@ class ManifestReader {
         },
         1);
     for (std::size_t k = 0; k < entries.size(); ++k) {
+      if (with_data && unread(entries[k].name)) {
+        volume.unread_fields[entries[k].name] = entries[k].header.components;
+        volume.field_files[entries[k].name] = entries[k].file;
+        continue;
+      }
       Field& field = volume.fields[entries[k].name];
       field.components = entries[k].header.components;
       if (!with_data) continue;
@@ -564,6 +573,10 @@ const Field& Volume::require(const std::string& name, int components, const std:
 
 Volume readVolume(const fs::path& manifest) { return ManifestReader(manifest).read(true); }
 
+Volume readVolume(const fs::path& manifest, const VolumeReadOptions& options) {
+  return ManifestReader(manifest).read(true, options.leave_unread);
+}
+
 Volume readVolumeHeader(const fs::path& manifest) { return ManifestReader(manifest).read(false); }
 
 std::string writeVolume(const Volume& volume, const fs::path& manifest, const VolumeWriteOptions& options) {
@@ -600,7 +613,7 @@ std::string writeVolume(const Volume& volume, const fs::path& manifest, const Vo
     if (options.detached) written.push_back(detachedDataPath(file, options.gzip));
   };
 
-  nlohmann::ordered_json table = nlohmann::ordered_json::object();
+  std::map<std::string, nlohmann::ordered_json> entries;  // by name: the manifest's table in name order
   for (const auto& [field_name, field] : volume.fields) {
     if (!isValidFieldName(field_name)) {
       throw RuntimeError(name + ": fields." + field_name + ": a field name may hold only letters, digits, '_' and '-'");
@@ -621,8 +634,30 @@ std::string writeVolume(const Volume& volume, const fs::path& manifest, const Vo
     } else {
       stage(file, header, field.data);
     }
-    table[field_name] = {{"file", file.filename().string()}, {"components", field.components}};
+    entries[field_name] = {{"file", file.filename().string()}, {"components", field.components}};
   }
+  // Fields left unread (readVolume's leave_unread): their files copied as they are, or, where the
+  // copy cannot be made (another encoding), read now and written.
+  for (const auto& [field_name, components] : volume.unread_fields) {
+    if (volume.fields.count(field_name)) continue;  // read or made since: written above
+    const auto source = volume.field_files.find(field_name);
+    if (source == volume.field_files.end())
+      throw RuntimeError(name + ": fields." + field_name + ": left unread, and no file to carry it from");
+    const fs::path file = dir / (prefix + field_name + extension);
+    NrrdHeader header = nrrdHeaderFor(grid, components);
+    header.generation = generation;
+    if (stageNrrdCopy(files, file, header, source->second, {options.gzip, options.detached})) {
+      written.push_back(file);
+    } else {
+      const std::vector<float> data = readNrrd(source->second).data;
+      if (data.size() != header.valueCount())
+        throw RuntimeError(name + ": fields." + field_name + ": " + source->second.string() + " no longer holds the field read");
+      stage(file, header, data);
+    }
+    entries[field_name] = {{"file", file.filename().string()}, {"components", components}};
+  }
+  nlohmann::ordered_json table = nlohmann::ordered_json::object();
+  for (auto& [field_name, entry] : entries) table[field_name] = std::move(entry);
 
   nlohmann::ordered_json receivers = nlohmann::ordered_json::array();
   for (const ReceiverMap& map : volume.receivers) {

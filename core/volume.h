@@ -48,6 +48,10 @@ struct Volume {
   nlohmann::json metadata = nlohmann::json::object();
   // The NRRD file each field was read from (readVolume), for VolumeWriteOptions::unchanged_fields.
   std::map<std::string, std::filesystem::path> field_files;
+  // Fields left in their files (VolumeReadOptions::leave_unread): name → components. They are not
+  // in `fields`; their files are in `field_files`, and writeVolume carries them into the volume it
+  // writes (copied, or read then, when the copy cannot be made).
+  std::map<std::string, int> unread_fields;
 
   // Adds (or replaces) a zero-filled field.
   Field& addField(const std::string& name, int components);
@@ -70,6 +74,14 @@ struct VolumeWriteOptions {
 // Reads a manifest and every field it names. Throws InputError (exit 2) naming the file and the
 // field for anything malformed (docs/volume-format.md, issue "Foundation" §3).
 Volume readVolume(const std::filesystem::path& manifest);
+
+struct VolumeReadOptions {
+  // Fields whose headers are read and checked but not their data (Volume::unread_fields): what a
+  // program will not look at, e.g. lightsim's CPU twin the n and ∇n of sharp constant-n materials
+  // (at 132³ 37 MB not inflated, nor held, nor zeroed by the kernel first).
+  std::vector<std::string> leave_unread;
+};
+Volume readVolume(const std::filesystem::path& manifest, const VolumeReadOptions& options);
 
 // A field or receiver name the format allows: letters, digits, '_' and '-' (it becomes part of a
 // file name). Readers refuse other names, the writer never writes them.

@@ -217,6 +217,45 @@ TEST(VolumeWrite, UnchangedFieldsAreCopiedFromTheFilesTheyWereReadFrom) {
   EXPECT_EQ(readVolume(dir / "gone.vol.json").fields.at("ior").data, changed.fields.at("ior").data);
 }
 
+// Fields left unread (VolumeReadOptions::leave_unread) are checked but not read, and carried into a
+// volume written from the one read: their files copied where the encoding allows, read and written
+// otherwise.
+TEST(VolumeRead, FieldsLeftUnreadAreCarriedIntoTheVolumeWritten) {
+  TempDir dir;
+  writeSample(dir);
+  const Volume whole = readVolume(dir / "scene.vol.json");
+  VolumeReadOptions options;
+  options.leave_unread = {"sigma_a", "opaque"};
+  const Volume lean = readVolume(dir / "scene.vol.json", options);
+  EXPECT_FALSE(lean.has("sigma_a"));
+  EXPECT_FALSE(lean.has("opaque"));
+  EXPECT_TRUE(lean.has("ior"));
+  EXPECT_EQ(lean.unread_fields, (std::map<std::string, int>{{"opaque", 4}, {"sigma_a", 3}}));
+  EXPECT_EQ(lean.field_files.at("sigma_a"), fieldPath(dir, "sigma_a"));
+
+  writeVolume(lean, dir / "carried.vol.json");  // gzip, as the sources: copied
+  expectSameVolume(whole, readVolume(dir / "carried.vol.json"));
+  EXPECT_EQ(samplesOf(fieldPath(dir / "carried.vol.json", "sigma_a")), samplesOf(fieldPath(dir, "sigma_a")));
+  VolumeWriteOptions raw;
+  raw.gzip = false;
+  writeVolume(lean, dir / "raw.vol.json", raw);  // another encoding: read now, then written
+  EXPECT_NE(readFile(fieldPath(dir / "raw.vol.json", "sigma_a")).find("encoding: raw"), std::string::npos);
+  expectSameVolume(whole, readVolume(dir / "raw.vol.json"));
+  // Nothing to carry it from: refused, and nothing written.
+  Volume orphan = lean;
+  orphan.field_files.erase("opaque");
+  EXPECT_THROW(writeVolume(orphan, dir / "orphan.vol.json"), RuntimeError);
+  EXPECT_FALSE(fs::exists(dir / "orphan.vol.json"));
+  // An unread field's file is still checked: gone, the read fails naming it.
+  fs::remove(fieldPath(dir, "opaque"));
+  try {
+    readVolume(dir / "scene.vol.json", options);
+    FAIL() << "no exception";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("opaque"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Volume, ManifestLayout) {
   TempDir dir;
   json manifest = writeSample(dir);

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "core/error.h"
 #include "core/parallel.h"
 #include "core/stopwatch.h"
 #include "lightsim/bake.h"
@@ -584,6 +585,41 @@ TEST(CpuSimulator, SameBitsWhateverTheThreadCount) {
   }
   EXPECT_EQ(one.receivers.size(), flight ? 1u : 0u);
   EXPECT_GT(one.stats.splits, 0u);
+  }
+}
+
+// In a volume whose sharp materials all have a constant n no sample reads the n and ∇n fields
+// (lightsim leaves them unread: VolumeReadOptions): without them the bake is the same to the bit;
+// with a graded material they are needed, and their absence is named.
+TEST(CpuSimulator, SharpConstantNMaterialsBakeWithoutTheNFields) {
+  const Volume whole = sharpVolume("procedural:sphere,r=0.5,ior=1.5", 20, cube(0.6));
+  Volume lean = whole;
+  lean.fields.erase("ior");
+  lean.fields.erase("ior_grad");
+  LightSpec light;
+  light.direction = glm::normalize(glm::dvec3(0.3, -1.0, 0.2));
+  SimulationOptions o;
+  ReceiverSpec floor;
+  floor.point = {0.0, -0.7, 0.0};
+  floor.half_extent = 1.5;
+  o.receiver = floor;
+  o.volume_deposits = true;
+  const BakeResult a = CpuSimulator(whole).run(light, o), b = CpuSimulator(lean).run(light, o);
+  ASSERT_EQ(a.receivers.size(), 1u);
+  ASSERT_EQ(b.receivers.size(), 1u);
+  EXPECT_EQ(a.receivers[0].irradiance, b.receivers[0].irradiance);
+  EXPECT_EQ(a.irradiance.data, b.irradiance.data);
+  EXPECT_EQ(a.stats.total_patches, b.stats.total_patches);
+  EXPECT_GT(a.stats.total_patches, 0u);
+  Volume graded = lean;
+  nlohmann::json table = graded.metadata.at("interfaces");
+  table["slots"][0]["graded"] = true;
+  graded.metadata["interfaces"] = table;
+  try {
+    CpuSimulator sim(graded);
+    FAIL() << "no exception";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("ior"), std::string::npos) << e.what();
   }
 }
 

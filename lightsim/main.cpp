@@ -544,9 +544,28 @@ int run(int argc, char** argv) {
     options.receiver = receiverFromScene(scene_path);
   }
   if (options.receiver) options.receiver->pitch_voxels = options_receiver_pitch;
-  Volume volume = readVolume(input);
-  volume.require("ior", 1, input);
-  volume.require("ior_grad", 3, input);
+  // The CPU twin reads no n or ∇n where every material is sharp with a constant n (VolumeSampler):
+  // then those fields stay in their files, copied into the output as they are.
+  VolumeReadOptions read_options;
+  {
+    const Volume header = readVolumeHeader(input);
+    const InterfaceTable table = interfaceTable(header, input);
+    SimulatorBackendOptions twin;
+    twin.backend = backend == "cpu" ? SimulatorBackend::Cpu : backend == "auto" ? SimulatorBackend::Auto : SimulatorBackend::Gl;
+    twin.gl = gl_backend;
+    const bool constant_n = !table.empty() && std::none_of(table.slots.begin(), table.slots.end(),
+                                                           [](const InterfaceSlot& s) { return s.graded || s.dispersion_b != 0.0; });
+    if (constant_n && !header.has("dispersion") && takesCpuTwinUnprobed(twin)) read_options.leave_unread = {"ior", "ior_grad"};
+  }
+  Volume volume = readVolume(input, read_options);
+  for (const auto& [name, components] : {std::pair<std::string, int>{"ior", 1}, {"ior_grad", 3}}) {
+    const auto unread = volume.unread_fields.find(name);
+    if (unread == volume.unread_fields.end()) {
+      volume.require(name, components, input);  // read, or named as missing
+    } else if (unread->second != components) {
+      throw InputError(input, name, std::to_string(unread->second) + " components, expected " + std::to_string(components));
+    }
+  }
   interfaceTable(volume, input);  // a malformed table is named with the file, before any work
   const std::vector<SpectralBand> bands = isDispersive(volume) ? spectralBands(band_count) : spectralBands(1);
   const std::vector<BakeLight> lights = bakeLights(lights_to_bake);

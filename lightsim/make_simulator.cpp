@@ -18,6 +18,17 @@ std::string gpuPathLacks(const Volume& volume, const SimulationOptions& simulati
   return "";
 }
 
+bool takesCpuTwinUnprobed(const SimulatorBackendOptions& options) {
+  if (options.backend == SimulatorBackend::Cpu) return true;
+  if (options.backend != SimulatorBackend::Auto) return false;
+  try {
+    if (gl::resolveGlBackend(gl::parseGlBackend(options.gl)) == gl::GlBackend::OSMesa) return true;
+  } catch (const std::exception&) {
+    return true;  // a bad --gl name: Auto takes the twin
+  }
+  return !gl::gpuDevicePresent();
+}
+
 std::unique_ptr<Simulator> makeSimulator(const Volume& volume, const SimulatorBackendOptions& options,
                                          const SimulationOptions* simulation) {
   SimulatorBackend backend = options.backend;

@@ -36,6 +36,11 @@ struct SimulatorBackendOptions {
   std::function<void(const std::string&)> report;
 };
 
+// Whether makeSimulator takes the CPU twin whatever the volume, known before any driver is loaded:
+// `--backend cpu`, or auto with OSMesa asked for or no GPU device on the machine. (Auto may also
+// take it after probing a software rasteriser; that is not known beforehand.)
+bool takesCpuTwinUnprobed(const SimulatorBackendOptions& options);
+
 // What the GPU path cannot do (ALGORITHM.md "Back ends"): a receiver map with point deposits.
 // Returns "" when it can bake `volume` with `simulation`, else the reason.
 std::string gpuPathLacks(const Volume& volume, const SimulationOptions& simulation);

@@ -46,8 +46,11 @@ QuietMap::QuietMap(const GridSpec& grid, const std::vector<glm::vec4>& ior_grad,
 
 QuietMap::QuietMap(const GridSpec& grid, const FieldViews& fields, const InterfaceTable& table) : grid_(grid) {
   const glm::ivec3 d = grid.dims;
-  if (d.x <= 0 || d.y <= 0 || d.z <= 0 || !fields.ior || !fields.grad) return;
   const bool sharp = !table.empty() && fields.distances;
+  // n and ∇n are looked at in graded materials only (and everywhere without sharp interfaces).
+  const bool graded_slot = std::any_of(table.slots.begin(), table.slots.end(), [](const InterfaceSlot& s) { return s.graded; });
+  const bool needs_n = !sharp || graded_slot;
+  if (d.x <= 0 || d.y <= 0 || d.z <= 0 || (needs_n && (!fields.ior || !fields.grad))) return;
   chooseBricks(sharp ? 100 : 160);
   const int slots = sharp ? static_cast<int>(table.slots.size()) : 0;
   auto signature = [&](std::size_t v) {

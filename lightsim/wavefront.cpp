@@ -120,8 +120,6 @@ glm::dvec4 sampleTrilinear(const Field& field, const GridSpec& grid, const glm::
 
 VolumeSampler::VolumeSampler(const Volume& volume)
     : grid_(volume.grid), h_(voxelEdge(volume.grid)), tap_scale_(tapScale(volume.grid)) {
-  const Field& ior = volume.require("ior", 1);
-  const Field& grad = volume.require("ior_grad", 3);
   const std::size_t n = grid_.count();
   // The copies below, in chunks of voxels in parallel.
   constexpr std::int64_t kChunk = 1 << 16;
@@ -136,13 +134,17 @@ VolumeSampler::VolumeSampler(const Volume& volume)
   const bool graded = std::any_of(table_.slots.begin(), table_.slots.end(), [](const InterfaceSlot& s) { return s.graded; });
   // n and ∇n are read from the fields only where a sample returns them: everywhere without sharp
   // interfaces, in graded materials with them (homogeneous materials and air have their own n).
-  // Elsewhere they are not copied (at 132³ that is 37 MB not written).
-  if (table_.empty() || graded) {
+  // Elsewhere they are not copied (at 132³ that is 37 MB not written), and need not have been
+  // read (VolumeReadOptions::leave_unread).
+  const bool reads_n = table_.empty() || graded;
+  const Field* ior = reads_n ? &volume.require("ior", 1) : volume.find("ior");
+  const Field* grad = reads_n ? &volume.require("ior_grad", 3) : volume.find("ior_grad");
+  if (reads_n) {
     ior_grad_.resize(n);
     forChunks([&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
-        const float* g = grad.voxel(i);
-        ior_grad_[i] = glm::vec4(ior.data[i], g[0], g[1], g[2]);
+        const float* g = grad->voxel(i);
+        ior_grad_[i] = glm::vec4(ior->data[i], g[0], g[1], g[2]);
       }
     });
   }
@@ -203,8 +205,8 @@ VolumeSampler::VolumeSampler(const Volume& volume)
   findMaterialAbsorption(volume);
   // The quiet bricks, from the volume's own fields (what the copies above would give).
   QuietMap::FieldViews views;
-  views.ior = ior.data.data();
-  views.grad = grad.data.data();
+  views.ior = ior ? ior->data.data() : nullptr;  // read only in graded materials (QuietMap)
+  views.grad = grad ? grad->data.data() : nullptr;
   if (d) views.distances = d->data.data();
   if (!sigma_a_.empty()) views.sigma_a = &sigma_a_[0].x;
   quiet_ = QuietMap(grid_, views, table_);
@@ -215,8 +217,8 @@ VolumeSampler::VolumeSampler(const Volume& volume)
     for (const InterfaceSlot& slot : table_.slots)
       if (!slot.graded) min_ior_ = std::min(min_ior_, slot.ior);
   }
-  if (!sharp() || graded)
-    for (const float v : ior.data) min_ior_ = std::min(min_ior_, static_cast<double>(v));  // graded slots and smoothed n
+  if (reads_n)
+    for (const float v : ior->data) min_ior_ = std::min(min_ior_, static_cast<double>(v));  // graded slots and smoothed n
 }
 
 void VolumeSampler::findMaterialAbsorption(const Volume& volume) {

@@ -100,7 +100,8 @@ glm::dvec4 sampleTrilinear(const Field& field, const GridSpec& grid, const glm::
 // of the fields (n and ∇n together, so one lookup serves both); thread-safe for reading.
 class VolumeSampler {
  public:
-  // Needs `ior` (1 component) and `ior_grad` (3); `sigma_a` (3) is optional (absent: σa = 0).
+  // Needs `ior` (1 component) and `ior_grad` (3) — unless every material is sharp with a constant n
+  // (no graded slot), where no sample reads them; `sigma_a` (3) is optional (absent: σa = 0).
   // Throws InputError naming the field otherwise.
   explicit VolumeSampler(const Volume& volume);
 
