@@ -1,5 +1,6 @@
 #include "viewer/loaded_scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <utility>
@@ -7,6 +8,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/error.h"
+#include "core/interfaces.h"
 #include "lightsim/scene_bake.h"
 
 namespace eik {
@@ -25,10 +27,28 @@ void warnMapLeftOut(const std::string& source, const std::string& map) {
                source.c_str(), map.c_str());
 }
 
-// The viewer needs n and ∇n (Eq. 5.11/5.12); every other field is optional.
+// The viewer needs n and ∇n (Eq. 5.11/5.12) — ∇n may have been left unread (SceneLoadOptions);
+// every other field is optional.
 void requireOptics(const Volume& volume, const std::string& source) {
   volume.require("ior", 1, source);
-  volume.require("ior_grad", 3, source);
+  const auto unread = volume.unread_fields.find("ior_grad");
+  if (unread == volume.unread_fields.end()) {
+    volume.require("ior_grad", 3, source);
+  } else if (unread->second != 3) {
+    throw InputError(source, "ior_grad", std::to_string(unread->second) + " components, expected 3");
+  }
+}
+
+// How to read a volume: with SceneLoadOptions::leave_constant_gradient_unread, a volume of sharp
+// constant-n materials (its manifest's interface table says so) without ∇n.
+Volume readOptics(const std::filesystem::path& path, const SceneLoadOptions& options) {
+  VolumeReadOptions read;
+  if (options.leave_constant_gradient_unread) {
+    const InterfaceTable table = interfaceTable(readVolumeHeader(path), path.string());
+    if (!table.empty() && std::none_of(table.slots.begin(), table.slots.end(), [](const InterfaceSlot& s) { return s.graded; }))
+      read.leave_unread = {"ior_grad"};
+  }
+  return readVolume(path, read);
 }
 
 // The lights a bare volume was baked with (lightsim's "lights" manifest entry when it summed
@@ -122,9 +142,11 @@ LoadedScene sceneFromVolumes(Scene scene, std::vector<Volume> volumes) {
   return loaded;
 }
 
-LoadedScene loadScene(const std::filesystem::path& input) {
+LoadedScene loadScene(const std::filesystem::path& input) { return loadScene(input, SceneLoadOptions{}); }
+
+LoadedScene loadScene(const std::filesystem::path& input, const SceneLoadOptions& options) {
   const std::string text = input.string();
-  if (endsWith(text, ".vol.json")) return sceneFromVolume(readVolume(input), text);
+  if (endsWith(text, ".vol.json")) return sceneFromVolume(readOptics(input, options), text);
   LoadedScene loaded;
   loaded.source = text;
   loaded.scene = readScene(input);
@@ -139,7 +161,7 @@ LoadedScene loadScene(const std::filesystem::path& input) {
     LoadedObject object;
     object.source =
         std::filesystem::absolute(loaded.scene.resolve("objects[" + std::to_string(i) + "].volume", spec.volume)).string();
-    object.volume = readVolume(object.source);
+    object.volume = readOptics(object.source, options);
     requireOptics(object.volume, object.source);
     // Scaled differently along its axes: the volume at world scale along each axis, placed with
     // scale 1, as lightsim bakes it (lightsim/scene_bake.h).

@@ -39,6 +39,14 @@ SceneCameraSpec framingCamera(const GridSpec& grid, double fov_y_deg = 40.0);
 // one without ior / ior_grad.
 LoadedScene loadScene(const std::filesystem::path& input);
 
+struct SceneLoadOptions {
+  // A headless render's: ∇n of a volume whose sharp materials all have a constant n is not read
+  // (the shader takes each material's n and never samples it; at 132³ 28 MB). The window (its
+  // re-bake) and --bench (the bare march uploads it) read it.
+  bool leave_constant_gradient_unread = false;
+};
+LoadedScene loadScene(const std::filesystem::path& input, const SceneLoadOptions& options);
+
 // In memory (tests): one volume as a bare-volume scene, or a scene with the given volumes in
 // order of scene.objects (whose `volume` strings are then only names).
 LoadedScene sceneFromVolume(Volume volume, const std::string& source = "volume");

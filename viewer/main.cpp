@@ -187,7 +187,9 @@ int run(int argc, char** argv) {
   context_options.backend = gl::parseGlBackend(gl_backend);
   std::optional<gl::DriverPreload> preload;
   if (!window_mode) preload.emplace(context_options);
-  LoadedScene scene = loadScene(input);
+  SceneLoadOptions load_options;
+  load_options.leave_constant_gradient_unread = !output.empty() && !bench;  // a headless render
+  LoadedScene scene = loadScene(input, load_options);
   const bool is_scene = !scene.bare_volume;
   const ToneMapper tonemap =
       parseToneMapper(!tonemap_text.empty() ? tonemap_text : is_scene ? scene.scene.render.tonemap : "aces");

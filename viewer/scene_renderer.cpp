@@ -187,7 +187,7 @@ struct SceneRenderer::Impl {
   // One object's textures, bounds and shader defines, from its volume (the constructor, replaceVolume).
   Object makeObject(const LoadedObject& loaded, const std::vector<float>* prepared_texels = nullptr) const {
     loaded.volume.require("ior", 1, loaded.source);
-    loaded.volume.require("ior_grad", 3, loaded.source);
+    if (!loaded.volume.unread_fields.count("ior_grad")) loaded.volume.require("ior_grad", 3, loaded.source);
     Object o;
     o.source = loaded.source;
     o.grid = loaded.volume.grid;

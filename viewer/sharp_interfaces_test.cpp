@@ -11,6 +11,7 @@
 #include <numbers>
 
 #include "core/image_io.h"
+#include "core/testing.h"
 #include "lightsim/cpu_simulator.h"
 #include "lightsim/bake.h"
 #include "lightsim/test_scenes.h"
@@ -134,6 +135,38 @@ TEST_F(SharpViewerTest, AVolumeOfConstantNUploadsItsUsedDistancesAlone) {
     EXPECT_EQ(differing, 0) << "output " << static_cast<int>(output);
     EXPECT_GT(lit, 400);  // the ball and the sky are there
   }
+}
+
+// A headless render leaves ∇n unread in a volume of sharp constant-n materials (SceneLoadOptions):
+// the picture is the one of the volume read whole, to the bit; a graded material's ∇n is read.
+TEST_F(SharpViewerTest, AHeadlessRenderLeavesAConstantNVolumesGradientUnread) {
+  test_support::TempDir dir;
+  writeVolume(sharpVolume("procedural:sphere,r=0.5,ior=1.5", 40, box({-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6})),
+              dir / "ball.vol.json");
+  SceneLoadOptions lean_options;
+  lean_options.leave_constant_gradient_unread = true;
+  LoadedScene whole = loadScene(dir / "ball.vol.json"), lean = loadScene(dir / "ball.vol.json", lean_options);
+  ASSERT_EQ(lean.objects.size(), 1u);
+  EXPECT_FALSE(lean.objects[0].volume.has("ior_grad"));
+  EXPECT_TRUE(lean.objects[0].volume.unread_fields.count("ior_grad"));
+  EXPECT_TRUE(lean.objects[0].volume.has("ior"));  // the analyses' (region, bricks, faces)
+  EXPECT_TRUE(whole.objects[0].volume.has("ior_grad"));
+  const Camera camera = lookAlong({0.3, 0.4, 2.0}, glm::normalize(glm::dvec3(-0.3, -0.4, -2.0)), 30.0);
+  for (LoadedScene* s : {&whole, &lean}) {
+    s->scene.lights.clear();
+    s->scene.environment.uniform = glm::dvec3(1.0);
+  }
+  RenderSettings settings;
+  const Image a = SceneRenderer(*shaders_, whole, settings).render(camera, {40, 40});
+  const Image b = SceneRenderer(*shaders_, lean, settings).render(camera, {40, 40});
+  EXPECT_EQ(a.pixels, b.pixels);
+  // A graded material needs ∇n: read whatever the option.
+  Volume graded = sharpVolume("procedural:sphere,r=0.5,ior=1.5", 24, box({-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6}));
+  nlohmann::json table = graded.metadata.at("interfaces");
+  table["slots"][0]["graded"] = true;
+  graded.metadata["interfaces"] = table;
+  writeVolume(graded, dir / "graded.vol.json");
+  EXPECT_TRUE(loadScene(dir / "graded.vol.json", lean_options).objects[0].volume.has("ior_grad"));
 }
 
 // Between sharp surfaces of constant n the march steps as far as the distance field allows

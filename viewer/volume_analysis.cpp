@@ -85,8 +85,8 @@ std::vector<float> homogeneousBricks(const Volume& volume, glm::ivec3& brick_dim
       0, static_cast<std::int64_t>(grid.count()),
       [&](std::int64_t i64) {
         const std::size_t i = static_cast<std::size_t>(i64);
-        const float* g = grad->voxel(i);
-        bool b = (std::abs(g[0]) + std::abs(g[1]) + std::abs(g[2])) * h > 1e-4;
+        const float* g = grad ? grad->voxel(i) : nullptr;  // ∇n left unread: 0 (constant-n materials)
+        bool b = g && (std::abs(g[0]) + std::abs(g[1]) + std::abs(g[2])) * h > 1e-4;
         if (emission) b = b || emission->voxel(i)[0] > 0 || emission->voxel(i)[1] > 0 || emission->voxel(i)[2] > 0;
         if (scatter) b = b || scatter->voxel(i)[0] > 0;
         if (opaque) b = b || opaque->voxel(i)[3] > 0;
