@@ -599,10 +599,7 @@ TEST(CpuSimulator, SharpConstantNMaterialsBakeWithoutTheNFields) {
   LightSpec light;
   light.direction = glm::normalize(glm::dvec3(0.3, -1.0, 0.2));
   SimulationOptions o;
-  ReceiverSpec floor;
-  floor.point = {0.0, -0.7, 0.0};
-  floor.half_extent = 1.5;
-  o.receiver = floor;
+  o.receiver = test_scenes::floorAt(-0.7, 1.5);
   o.volume_deposits = true;
   const BakeResult a = CpuSimulator(whole).run(light, o), b = CpuSimulator(lean).run(light, o);
   ASSERT_EQ(a.receivers.size(), 1u);

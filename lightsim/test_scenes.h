@@ -128,6 +128,14 @@ inline Bounds cube(double half) {
   return b;
 }
 
+// A floor y = height facing up, as a receiver of half extent `half_extent` (its map).
+inline ReceiverSpec floorAt(double height, double half_extent) {
+  ReceiverSpec floor;
+  floor.point = {0.0, height, 0.0};
+  floor.half_extent = half_extent;
+  return floor;
+}
+
 inline Bounds box(const glm::dvec3& lo, const glm::dvec3& hi) {
   Bounds b;
   b.min = lo;
