@@ -102,7 +102,7 @@ InterfaceTable interfaceTable(const Volume& volume, const std::string& source) {
   if (has_field && !has_table)
     throw InputError(source, "interfaces", "the volume has an interfaces field but no interfaces table");
   if (!has_field) throw InputError(source, "fields.interfaces", "the manifest lists interfaces but has no such field");
-  volume.require("interfaces", 4, source);
+  const int components = volume.find("interfaces")->components;
   const nlohmann::json& j = volume.metadata.at("interfaces");
   if (!j.is_object()) throw InputError(source, "interfaces", "expected an object");
   for (auto it = j.begin(); it != j.end(); ++it)
@@ -152,11 +152,42 @@ InterfaceTable interfaceTable(const Volume& volume, const std::string& source) {
     }
     table.slots.push_back(slot);
   }
+  // One distance per slot, or four (the unused slots' +band: volumes written before).
+  if (components != static_cast<int>(table.slots.size()) && components != kMaxInterfaceSlots)
+    throw InputError(source, "fields.interfaces",
+                     std::to_string(components) + " components for " + std::to_string(table.slots.size()) +
+                         " slots (expected one per slot, or " + std::to_string(kMaxInterfaceSlots) + ")");
   return table;
 }
 
-std::optional<float> unusedSlotDistance(const Field& interfaces, int used) {
-  if (used >= interfaces.components || interfaces.data.empty()) return std::nullopt;
+Field fourSlotDistances(const Field& interfaces, double band) {
+  if (interfaces.components >= kMaxInterfaceSlots) return interfaces;
+  Field four;
+  four.components = kMaxInterfaceSlots;
+  const std::size_t voxels = interfaces.data.size() / static_cast<std::size_t>(interfaces.components);
+  four.data.assign(voxels * kMaxInterfaceSlots, static_cast<float>(band));
+  for (std::size_t i = 0; i < voxels; ++i) std::copy_n(interfaces.voxel(i), interfaces.components, four.voxel(i));
+  return four;
+}
+
+bool constantSlots(const InterfaceTable& table) {
+  return !table.empty() && std::none_of(table.slots.begin(), table.slots.end(), [](const InterfaceSlot& s) { return s.graded; });
+}
+
+const Field* iorGradient(const Volume& volume, const InterfaceTable& table, const std::string& source) {
+  if (const auto unread = volume.unread_fields.find("ior_grad"); unread != volume.unread_fields.end()) {
+    if (unread->second != 3)
+      throw InputError(source, "ior_grad", std::to_string(unread->second) + " components, expected 3");
+    return nullptr;
+  }
+  if (!volume.has("ior_grad") && constantSlots(table)) return nullptr;
+  return &volume.require("ior_grad", 3, source);
+}
+
+std::optional<float> unusedSlotDistance(const Field& interfaces, int used, double band) {
+  if (used >= interfaces.components)
+    return interfaces.components < kMaxInterfaceSlots ? std::optional<float>(static_cast<float>(band)) : std::nullopt;
+  if (interfaces.data.empty()) return std::nullopt;
   const std::size_t stride = static_cast<std::size_t>(interfaces.components);
   const std::size_t voxels = interfaces.data.size() / stride;
   const float value = interfaces.data[static_cast<std::size_t>(used)];

@@ -78,11 +78,28 @@ MaterialValues deepMaterialValues(const Volume& volume, const InterfaceTable& ta
 // cube's corners lie √3/2 edges from its centre, so nothing of another object is blended in.
 constexpr double kDeepVoxels = 1.0;
 
-// The one value every unused slot's distance holds (docs/volume-format.md: +band) in the
-// `interfaces` field (4 components) beyond the first `used` slots, or nullopt where those vary (a
-// hand-made file) or every slot is used. Then the used slots' distances alone describe the field:
-// lightsim's sampler keeps them alone, the viewer uploads them alone.
-std::optional<float> unusedSlotDistance(const Field& interfaces, int used);
+// The `interfaces` field holds one distance per slot (components = slot count, as voxelize writes
+// it) or four, the unused slots' +band (volumes written before; docs/volume-format.md). The one value
+// every distance beyond the first `used` holds: `band` where the field stores no more than those
+// (less than four), the stored one where the four's unused slots all hold one value, nullopt where
+// they vary (a hand-made file) or all four slots are used. Then the used slots' distances alone
+// describe the field: lightsim's sampler keeps them alone, the viewer uploads them alone.
+std::optional<float> unusedSlotDistance(const Field& interfaces, int used, double band);
+
+// The `interfaces` field as four distances a voxel, the slots beyond those stored holding `band`
+// (what a field of one distance per slot stands for): for readers that sample all four at once
+// (lightsim's GPU passes, RGBA).
+Field fourSlotDistances(const Field& interfaces, double band);
+
+// Every material sharp with a constant n (no graded slot): n is the slot's own and ∇n = 0 wherever a
+// ray or a patch is, so nothing reads the ior or ior_grad fields for optics, and voxelize leaves
+// ior_grad out of such a volume (it would be 0 throughout).
+bool constantSlots(const InterfaceTable& table);
+
+// ∇n of a volume: its ior_grad field (3 components), or nullptr where it is left out as 0
+// throughout (constantSlots) or left unread (Volume::unread_fields). An InputError naming `source`
+// where any other volume lacks it.
+const Field* iorGradient(const Volume& volume, const InterfaceTable& table, const std::string& source = "volume");
 
 // Which material a point is in: the slot index, or −1 for air.
 inline int materialSlot(const glm::dvec4& distances, int slot_count) {

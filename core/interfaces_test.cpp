@@ -80,20 +80,68 @@ TEST(Interfaces, TheUnusedSlotsDistanceIsOneConstantOrNone) {
   d.components = 4;
   const std::size_t voxels = 200000;  // several of the check's chunks
   d.data.resize(voxels * 4);
+  const double kBand = 0.07;  // the table's; a field of four holds its own (0.05 here), which wins
   for (std::size_t i = 0; i < voxels; ++i) {
     d.data[i * 4] = static_cast<float>(i % 7) - 3.0f;  // slot 0 used
     d.data[i * 4 + 1] = d.data[i * 4 + 2] = d.data[i * 4 + 3] = 0.05f;  // +band
   }
-  ASSERT_TRUE(unusedSlotDistance(d, 1).has_value());
-  EXPECT_EQ(*unusedSlotDistance(d, 1), 0.05f);
-  EXPECT_FALSE(unusedSlotDistance(d, 0).has_value());  // slot 0 is not one constant
-  EXPECT_FALSE(unusedSlotDistance(d, 4).has_value());  // nothing unused
+  ASSERT_TRUE(unusedSlotDistance(d, 1, kBand).has_value());
+  EXPECT_EQ(*unusedSlotDistance(d, 1, kBand), 0.05f);
+  EXPECT_FALSE(unusedSlotDistance(d, 0, kBand).has_value());  // slot 0 is not one constant
+  EXPECT_FALSE(unusedSlotDistance(d, 4, kBand).has_value());  // nothing unused
   d.data[(voxels - 1) * 4 + 3] = 0.06f;               // one voxel off, in the last chunk
-  EXPECT_FALSE(unusedSlotDistance(d, 1).has_value());
-  EXPECT_FALSE(unusedSlotDistance(d, 3).has_value());
+  EXPECT_FALSE(unusedSlotDistance(d, 1, kBand).has_value());
+  EXPECT_FALSE(unusedSlotDistance(d, 3, kBand).has_value());
   d.data[(voxels - 1) * 4 + 3] = 0.05f;
   d.data[(voxels - 1) * 4 + 2] = 0.06f;
-  EXPECT_TRUE(unusedSlotDistance(d, 3).has_value());  // slot 2 is used here
+  EXPECT_TRUE(unusedSlotDistance(d, 3, kBand).has_value());  // slot 2 is used here
+  // One distance per slot (as voxelize writes them): nothing unused is stored, the rest is +band.
+  Field lean;
+  lean.components = 2;
+  lean.data.assign(voxels * 2, -1.0f);
+  ASSERT_TRUE(unusedSlotDistance(lean, 2, kBand).has_value());
+  EXPECT_EQ(*unusedSlotDistance(lean, 2, kBand), static_cast<float>(kBand));
+  lean.components = 4;  // four slots, all used
+  lean.data.assign(voxels * 4, -1.0f);
+  EXPECT_FALSE(unusedSlotDistance(lean, 4, kBand).has_value());
+}
+
+TEST(Interfaces, TheFieldHoldsOneDistancePerSlotOrFour) {
+  Volume v;
+  v.grid.dims = {2, 2, 2};
+  v.metadata["interfaces"] = {{"band", 0.05}, {"slots", {{{"name", "glass"}, {"ior", 1.5}}, {{"name", "wine"}, {"ior", 1.34}}}}};
+  for (const int components : {2, 4}) {
+    v.addField("interfaces", components);
+    EXPECT_EQ(interfaceTable(v).slots.size(), 2u) << components;
+  }
+  for (const int components : {1, 3}) {
+    v.addField("interfaces", components);
+    EXPECT_CONTAINS(inputErrorOf([&] { interfaceTable(v, "two.vol.json"); }),
+                    "two.vol.json: fields.interfaces: " + std::to_string(components) + " components for 2 slots");
+  }
+}
+
+TEST(Interfaces, GradientIsLeftOutOnlyWhereEveryMaterialHasAConstantN) {
+  Volume v;
+  v.grid.dims = {2, 2, 2};
+  v.addField("interfaces", 1);
+  v.metadata["interfaces"] = {{"band", 0.05}, {"slots", {{{"name", "glass"}, {"ior", 1.5}}}}};
+  const InterfaceTable constant = interfaceTable(v);
+  EXPECT_TRUE(constantSlots(constant));
+  EXPECT_EQ(iorGradient(v, constant), nullptr);  // left out: 0 throughout
+  v.addField("ior_grad", 3);
+  EXPECT_EQ(iorGradient(v, constant), &v.fields.at("ior_grad"));
+  v.fields.erase("ior_grad");
+  v.metadata["interfaces"]["slots"][0]["graded"] = true;
+  const InterfaceTable graded = interfaceTable(v);
+  EXPECT_FALSE(constantSlots(graded));
+  EXPECT_CONTAINS(inputErrorOf([&] { iorGradient(v, graded, "lens.vol.json"); }), "ior_grad");
+  EXPECT_CONTAINS(inputErrorOf([&] { iorGradient(Volume{}, InterfaceTable{}, "smoothed.vol.json"); }), "ior_grad");
+  EXPECT_FALSE(constantSlots(InterfaceTable{}));  // no table: a smoothed n, whose ∇n is read
+  v.unread_fields["ior_grad"] = 3;                // left in its file
+  EXPECT_EQ(iorGradient(v, graded), nullptr);
+  v.unread_fields["ior_grad"] = 4;
+  EXPECT_CONTAINS(inputErrorOf([&] { iorGradient(v, graded, "lens.vol.json"); }), "4 components, expected 3");
 }
 
 TEST(Interfaces, TheMaterialIsTheFirstSlotWithANegativeDistance) {

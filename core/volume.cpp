@@ -523,7 +523,7 @@ const std::vector<FieldSpec>& knownFields() {
       {"dispersion", 1, "Cauchy B (um^2): n(lambda) = n + B (1/lambda^2 - 1/lambda_d^2)"},
       {"irradiance", 3, "baked RGB irradiance (from lightsim)"},
       {"light_dir", 3, "baked unit local light direction (from lightsim)"},
-      {"interfaces", 4, "signed distance to the surface of each interface slot (negative inside)"},
+      {"interfaces", 0, "signed distance to the surface of each interface slot (negative inside), one per slot"},
   };
   return fields;
 }

@@ -20,11 +20,11 @@ namespace eik {
 // (written and read like any field) but programs only interpret these.
 struct FieldSpec {
   std::string_view name;
-  int components;
+  int components;  // 0: 1 to 4 (interfaces: one per slot, checked against its table by interfaceTable)
   std::string_view meaning;
 };
 const std::vector<FieldSpec>& knownFields();
-// Component count of a known field, or 0 for an unknown name.
+// Component count of a known field, or 0 for an unknown name or a field of 1 to 4 (interfaces).
 int knownFieldComponents(std::string_view name);
 
 // One field: `components` floats per voxel, interleaved, voxels x fastest.

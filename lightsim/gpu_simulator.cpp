@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/interfaces.h"
 #include "core/stopwatch.h"
 #include "gl/scoped_state.h"
 #include "gl/shader_library.h"
@@ -47,13 +48,17 @@ std::string bytesText(std::size_t bytes) {
   return text;
 }
 
-// Only the fields the simulator reads, so nothing else takes texture memory.
+// Only the fields the simulator reads, so nothing else takes texture memory. The passes sample
+// the four slot distances and (n, ∇n) as one RGBA texture each: a field of fewer distances (one per
+// slot) gets the unused slots' +band, a volume without ∇n (core/interfaces.h constantSlots) zeros.
 Volume simulationFields(const Volume& volume) {
   Volume v;
   v.grid = volume.grid;
   for (const char* name : {"ior", "ior_grad", "sigma_a", "interfaces"}) {
     if (const Field* f = volume.find(name)) v.fields[name] = *f;
   }
+  if (const Field* d = volume.find("interfaces")) v.fields["interfaces"] = fourSlotDistances(*d, interfaceTable(volume).band);
+  if (!v.has("ior_grad") && v.has("ior")) v.addField("ior_grad", 3);
   return v;
 }
 

@@ -414,8 +414,7 @@ int run(int argc, char** argv) {
       volumes.push_back(readVolume(path));
       sources.push_back(path.string());
       volumes.back().require("ior", 1, sources.back());
-      volumes.back().require("ior_grad", 3, sources.back());
-      interfaceTable(volumes.back(), sources.back());
+      iorGradient(volumes.back(), interfaceTable(volumes.back(), sources.back()), sources.back());
       // Scaled differently along its axes: baked (and written) as the volume at world scale along
       // each axis, placed with scale 1 in the baked SCENE.json (scene_bake.h takeInAxisScale); the
       // maps it held are baked anew.
@@ -553,20 +552,21 @@ int run(int argc, char** argv) {
     SimulatorBackendOptions twin;
     twin.backend = backend == "cpu" ? SimulatorBackend::Cpu : backend == "auto" ? SimulatorBackend::Auto : SimulatorBackend::Gl;
     twin.gl = gl_backend;
-    const bool constant_n = !table.empty() && std::none_of(table.slots.begin(), table.slots.end(),
-                                                           [](const InterfaceSlot& s) { return s.graded || s.dispersion_b != 0.0; });
-    if (constant_n && !header.has("dispersion") && takesCpuTwinUnprobed(twin)) read_options.leave_unread = {"ior", "ior_grad"};
+    const bool constant_n = constantSlots(table) && std::none_of(table.slots.begin(), table.slots.end(),
+                                                                 [](const InterfaceSlot& s) { return s.dispersion_b != 0.0; });
+    if (constant_n && !header.has("dispersion") && takesCpuTwinUnprobed(twin))
+      for (const char* name : {"ior", "ior_grad"})
+        if (header.has(name)) read_options.leave_unread.push_back(name);  // ∇n may be left out (voxelize)
   }
   Volume volume = readVolume(input, read_options);
-  for (const auto& [name, components] : {std::pair<std::string, int>{"ior", 1}, {"ior_grad", 3}}) {
-    const auto unread = volume.unread_fields.find(name);
-    if (unread == volume.unread_fields.end()) {
-      volume.require(name, components, input);  // read, or named as missing
-    } else if (unread->second != components) {
-      throw InputError(input, name, std::to_string(unread->second) + " components, expected " + std::to_string(components));
-    }
+  if (const auto unread = volume.unread_fields.find("ior"); unread == volume.unread_fields.end()) {
+    volume.require("ior", 1, input);  // read, or named as missing
+  } else if (unread->second != 1) {
+    throw InputError(input, "ior", std::to_string(unread->second) + " components, expected 1");
   }
-  interfaceTable(volume, input);  // a malformed table is named with the file, before any work
+  // A malformed table is named with the file, before any work; ∇n read, left unread, or left out
+  // where the table says it is 0 throughout.
+  iorGradient(volume, interfaceTable(volume, input), input);
   const std::vector<SpectralBand> bands = isDispersive(volume) ? spectralBands(band_count) : spectralBands(1);
   const std::vector<BakeLight> lights = bakeLights(lights_to_bake);
   std::unique_ptr<VolumeBake> bake = prepare(volume, input, lights, options, 1.0, bands);

@@ -47,7 +47,7 @@ class QuietMap {
     std::size_t ior_stride = 1;
     const float* grad = nullptr;       // ∇n (3 floats), every grad_stride floats
     std::size_t grad_stride = 3;
-    const float* distances = nullptr;  // the four slot distances, every distances_stride floats; null: none
+    const float* distances = nullptr;  // the slot distances, every distances_stride floats; null: none
     std::size_t distances_stride = 4;
     const float* sigma_a = nullptr;    // σa (3 floats), every sigma_stride floats; null: none
     std::size_t sigma_stride = 3;

@@ -55,7 +55,9 @@ TEST(BakeFrame, CarriesTheLightAndTheGroundIntoTheVolumesAxes) {
 // At world scale the grid's box is s times as large, a signed distance s times as long (and the
 // band), ∇n 1/s as steep; n, σa and the rest stay (σa is per world unit already).
 TEST(BakeFrame, TheVolumeAtWorldScale) {
-  const Volume volume = test_scenes::sharpVolume("procedural:sphere,r=0.5,center=0.1:0:0,ior=1.5,sigma_a=0.3:0.3:0.3", 16);
+  Volume volume = test_scenes::sharpVolume("procedural:sphere,r=0.5,center=0.1:0:0,ior=1.5,sigma_a=0.3:0.3:0.3", 16);
+  Field& grad = volume.addField("ior_grad", 3);  // a ∇n that is not 0 (voxelize leaves this one's out)
+  for (std::size_t i = 0; i < grad.data.size(); ++i) grad.data[i] = static_cast<float>(1 + i % 3);
   const Volume scaled = volumeAtWorldScale(volume, 2.5);
   EXPECT_EQ(scaled.grid.dims, volume.grid.dims);
   EXPECT_NEAR(glm::length(scaled.grid.bounds_min - 2.5 * volume.grid.bounds_min), 0.0, 1e-12);
@@ -90,7 +92,7 @@ TEST(BakeFrame, TheVolumeAtWorldScale) {
 // 1.5 : 0.75 : 1.2 the map cannot stay square and is left out, named.
 TEST(BakeFrame, TheVolumeAtWorldScaleAlongItsAxes) {
   Volume volume = test_scenes::sharpVolume("procedural:sphere,r=0.5,center=0.1:0:0,ior=1.5", 16);
-  Field& grad = volume.fields.at("ior_grad");
+  Field& grad = volume.addField("ior_grad", 3);  // voxelize leaves this one's out (0 throughout)
   for (std::size_t i = 0; i < grad.data.size(); ++i) grad.data[i] = static_cast<float>(1 + i % 3);
   Field& dir = volume.addField("light_dir", 3);
   for (std::size_t i = 0; i < dir.data.size(); i += 3) {

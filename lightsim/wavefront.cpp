@@ -131,12 +131,11 @@ VolumeSampler::VolumeSampler(const Volume& volume)
     });
   };
   table_ = interfaceTable(volume);
-  const bool graded = std::any_of(table_.slots.begin(), table_.slots.end(), [](const InterfaceSlot& s) { return s.graded; });
   // n and ∇n are read from the fields only where a sample returns them: everywhere without sharp
   // interfaces, in graded materials with them (homogeneous materials and air have their own n).
   // Elsewhere they are not copied (at 132³ that is 37 MB not written), and need not have been
-  // read (VolumeReadOptions::leave_unread).
-  const bool reads_n = table_.empty() || graded;
+  // read (VolumeReadOptions::leave_unread) nor written (voxelize leaves ∇n out).
+  const bool reads_n = !constantSlots(table_);
   const Field* ior = reads_n ? &volume.require("ior", 1) : volume.find("ior");
   const Field* grad = reads_n ? &volume.require("ior_grad", 3) : volume.find("ior_grad");
   if (reads_n) {
@@ -150,9 +149,9 @@ VolumeSampler::VolumeSampler(const Volume& volume)
   }
   const Field* d = nullptr;
   if (!table_.empty()) {
-    d = &volume.require("interfaces", 4);
+    d = volume.find("interfaces");  // one distance per slot, or four (interfaceTable checked which)
     const int used = slotCount();
-    const std::optional<float> unused = unusedSlotDistance(*d, used);
+    const std::optional<float> unused = unusedSlotDistance(*d, used, table_.band);
     unused_distance_ = unused.value_or(0.0f);
     if (unused) {
       used_distances_.resize(n * static_cast<std::size_t>(used));
@@ -207,7 +206,10 @@ VolumeSampler::VolumeSampler(const Volume& volume)
   QuietMap::FieldViews views;
   views.ior = ior ? ior->data.data() : nullptr;  // read only in graded materials (QuietMap)
   views.grad = grad ? grad->data.data() : nullptr;
-  if (d) views.distances = d->data.data();
+  if (d) {
+    views.distances = d->data.data();
+    views.distances_stride = static_cast<std::size_t>(d->components);
+  }
   if (!sigma_a_.empty()) views.sigma_a = &sigma_a_[0].x;
   quiet_ = QuietMap(grid_, views, table_);
   // The smallest n: every material's and air's with sharp interfaces, the field's where it is read.

@@ -123,15 +123,24 @@ const std::vector<std::vector<std::string>> kSharpScenes = {
     {"procedural:layered_cube,size=0.8,radius=0.1"}};
 
 // The slot distances read from the used slots alone (one to three floats a voxel) are the
-// trilinear interpolant of the interfaces field as it is (all four channels), and a field whose
-// unused channels vary is read whole.
+// trilinear interpolant of the interfaces field with all four channels: of a field of one distance
+// per slot (as voxelize writes it) the unused slots read +band; of a field of four (volumes written
+// before) the four as they are, and one whose unused channels vary is read whole.
 TEST(VolumeSampler, SlotDistancesAreTheInterfacesFieldsInterpolant) {
   std::mt19937 rng(11);
   for (const auto& specs : kSharpScenes) {
     Volume v = test_scenes::sharpVolume(specs, 24);
-    const int slots = static_cast<int>(interfaceTable(v).slots.size());
-    for (int vary = 0; vary < 2; ++vary) {
-      if (vary && slots < 4) v.fields.at("interfaces").voxel(7)[3] += 0.5f;  // an unused channel that varies
+    const InterfaceTable table = interfaceTable(v);
+    const int slots = static_cast<int>(table.slots.size());
+    ASSERT_EQ(v.fields.at("interfaces").components, slots);
+    const Field lean = v.fields.at("interfaces");
+    Field four = fourSlotDistances(lean, table.band);
+    for (int form = 0; form < 3; ++form) {
+      if (form > 0) v.fields.at("interfaces") = four;
+      if (form == 2 && slots < 4) {
+        four.voxel(7)[3] += 0.5f;  // an unused channel that varies
+        v.fields.at("interfaces") = four;
+      }
       const VolumeSampler sampler(v);
       ASSERT_EQ(sampler.slotCount(), slots);
       const GridSpec& g = v.grid;
@@ -140,8 +149,9 @@ TEST(VolumeSampler, SlotDistancesAreTheInterfacesFieldsInterpolant) {
         // Inside the grid and a little beyond it (clamp to edge).
         const glm::dvec3 p = g.bounds_min + (glm::dvec3(u(rng), u(rng), u(rng)) * 1.1 - 0.05) * g.extent();
         const glm::dvec4 got = sampler.distances(p);
-        const glm::dvec4 want = sampleTrilinear(v.fields.at("interfaces"), g, p);
-        for (int k = 0; k < 4; ++k) EXPECT_NEAR(got[k], want[k], 1e-9 * (1.0 + std::abs(want[k]))) << slots << " slots, k " << k;
+        const glm::dvec4 want = sampleTrilinear(four, g, p);
+        for (int k = 0; k < 4; ++k)
+          EXPECT_NEAR(got[k], want[k], 1e-9 * (1.0 + std::abs(want[k]))) << slots << " slots, form " << form << ", k " << k;
       }
     }
   }

@@ -102,7 +102,10 @@ TEST(VoxelizeCli, ProceduralSphereWritesAVolumeAndStats) {
                                    "32", "--stats", "stats.json"});
   ASSERT_EQ(r.exit_code, 0) << r.output;
   Volume v = readVolume(dir / "ball.vol.json");
-  EXPECT_TRUE(v.has("ior") && v.has("ior_grad") && v.has("sigma_a"));
+  EXPECT_TRUE(v.has("ior") && v.has("sigma_a"));
+  // Sharp (the default) and of one constant n: one distance a voxel, no ∇n (0 throughout).
+  EXPECT_FALSE(v.has("ior_grad"));
+  EXPECT_EQ(v.fields.at("interfaces").components, 1);
   EXPECT_EQ(v.grid.dims.x, 32 + 2 * 3);  // --res on the longest axis plus 3 voxels of padding per side
   json stats = json::parse(readFile(dir / "stats.json"));
   EXPECT_GT(stats["time_total_s"].get<double>(), 0.0);

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "core/error.h"
+#include "core/interfaces.h"
 #include "core/stopwatch.h"
 #include "gl/framebuffer.h"
 #include "viewer/scene_renderer.h"
@@ -49,13 +50,16 @@ BareMarch::BareMarch(const gl::ShaderLibrary& shaders, const std::vector<BareObj
     p.grid = object.volume->grid;
     p.object_to_world = object.object_to_world;
     const Field& ior = object.volume->require("ior", 1, object.source);
-    const Field& grad = object.volume->require("ior_grad", 3, object.source);
+    // ∇n, or 0 where the volume leaves it out (core/interfaces.h iorGradient).
+    const Field* grad = iorGradient(*object.volume, interfaceTable(*object.volume, object.source), object.source);
     const std::size_t count = p.grid.count();
     std::vector<float> packed(4 * count);
     for (std::size_t i = 0; i < count; ++i) {
-      packed[4 * i + 0] = grad.data[3 * i + 0];
-      packed[4 * i + 1] = grad.data[3 * i + 1];
-      packed[4 * i + 2] = grad.data[3 * i + 2];
+      if (grad) {
+        packed[4 * i + 0] = grad->data[3 * i + 0];
+        packed[4 * i + 1] = grad->data[3 * i + 1];
+        packed[4 * i + 2] = grad->data[3 * i + 2];
+      }
       packed[4 * i + 3] = ior.data[i];
     }
     gl::checkTexture3DSize(p.grid.dims, object.source + " (packed n, grad n)");

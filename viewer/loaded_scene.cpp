@@ -27,16 +27,11 @@ void warnMapLeftOut(const std::string& source, const std::string& map) {
                source.c_str(), map.c_str());
 }
 
-// The viewer needs n and ∇n (Eq. 5.11/5.12) — ∇n may have been left unread (SceneLoadOptions);
-// every other field is optional.
+// The viewer needs n and ∇n (Eq. 5.11/5.12) — ∇n may have been left unread (SceneLoadOptions) or
+// left out as 0 throughout (core/interfaces.h iorGradient); every other field is optional.
 void requireOptics(const Volume& volume, const std::string& source) {
   volume.require("ior", 1, source);
-  const auto unread = volume.unread_fields.find("ior_grad");
-  if (unread == volume.unread_fields.end()) {
-    volume.require("ior_grad", 3, source);
-  } else if (unread->second != 3) {
-    throw InputError(source, "ior_grad", std::to_string(unread->second) + " components, expected 3");
-  }
+  iorGradient(volume, interfaceTable(volume, source), source);
 }
 
 // How to read a volume: with SceneLoadOptions::leave_constant_gradient_unread, a volume of sharp
@@ -44,9 +39,8 @@ void requireOptics(const Volume& volume, const std::string& source) {
 Volume readOptics(const std::filesystem::path& path, const SceneLoadOptions& options) {
   VolumeReadOptions read;
   if (options.leave_constant_gradient_unread) {
-    const InterfaceTable table = interfaceTable(readVolumeHeader(path), path.string());
-    if (!table.empty() && std::none_of(table.slots.begin(), table.slots.end(), [](const InterfaceSlot& s) { return s.graded; }))
-      read.leave_unread = {"ior_grad"};
+    const Volume header = readVolumeHeader(path);
+    if (constantSlots(interfaceTable(header, path.string())) && header.has("ior_grad")) read.leave_unread = {"ior_grad"};
   }
   return readVolume(path, read);
 }

@@ -182,8 +182,7 @@ std::string interfaceDefines(const InterfaceTable& table) {
   out += "#define SLOT_GRADED " + vec4Of([](const InterfaceSlot& s) { return s.graded ? 1.0 : 0.0; }) + "\n";
   out += "#define SLOT_OPAQUE " + vec4Of([](const InterfaceSlot& s) { return s.opaque ? 1.0 : 0.0; }) + "\n";
   // No graded slot: n is a constant wherever the ray is, and the march never reads the ior field.
-  if (std::none_of(table.slots.begin(), table.slots.end(), [](const InterfaceSlot& s) { return s.graded; }))
-    out += "#define CONSTANT_SLOTS 1\n";
+  if (constantSlots(table)) out += "#define CONSTANT_SLOTS 1\n";
   return out;
 }
 

@@ -187,7 +187,8 @@ struct SceneRenderer::Impl {
   // One object's textures, bounds and shader defines, from its volume (the constructor, replaceVolume).
   Object makeObject(const LoadedObject& loaded, const std::vector<float>* prepared_texels = nullptr) const {
     loaded.volume.require("ior", 1, loaded.source);
-    if (!loaded.volume.unread_fields.count("ior_grad")) loaded.volume.require("ior_grad", 3, loaded.source);
+    const InterfaceTable table = interfaceTable(loaded.volume, loaded.source);
+    iorGradient(loaded.volume, table, loaded.source);
     Object o;
     o.source = loaded.source;
     o.grid = loaded.volume.grid;
@@ -200,7 +201,6 @@ struct SceneRenderer::Impl {
     gl::VolumeTextureOptions options;
     options.source = loaded.source;
     options.padToRGBA = true;  // llvmpipe samples RGBA32F faster than RGB32F (σa: about 10 % a frame)
-    const InterfaceTable table = interfaceTable(loaded.volume, loaded.source);
     const SlotMedia media = slotMedia(loaded.volume, table);
     o.defines = interfaceDefines(table) + slotMediumDefines(media);
     // σa one constant in every material: the shader takes it from MEDIUM_SIGMA_A and never samples
@@ -213,16 +213,17 @@ struct SceneRenderer::Impl {
     // Sharp materials of constant n (CONSTANT_SLOTS): n is the slot's and ∇n = 0 wherever a ray
     // is, so the shader never samples the ior texture and it is not uploaded (at 132³ its RGBA32F
     // texture and the staging copy are 2 × 37 MB that the kernel would zero).
-    const bool constant_slots = !table.empty() && std::none_of(table.slots.begin(), table.slots.end(),
-                                                               [](const InterfaceSlot& s) { return s.graded; });
+    const bool constant_slots = constantSlots(table);
     if (constant_slots) {
       options.leave_out.push_back("ior");
       options.leave_out.push_back("ior_grad");
     }
-    // One or two slots: their distances alone (R32F, RG32F; a quarter or half of the RGBA32F
-    // texture), the unused slots' one value a constant of the shader.
-    if (const int used = static_cast<int>(table.slots.size()); used > 0 && used < 3) {
-      if (const std::optional<float> unused = unusedSlotDistance(loaded.volume.require("interfaces", 4, loaded.source), used)) {
+    // The used slots' distances alone: one or two (R32F, RG32F; a quarter or half of the RGBA32F
+    // texture), or three of a field that holds one per slot (RGB padded to RGBA); the unused slots'
+    // one value a constant of the shader.
+    const Field* distances = loaded.volume.find("interfaces");
+    if (const int used = static_cast<int>(table.slots.size()); distances && (used < 3 || distances->components < 4)) {
+      if (const std::optional<float> unused = unusedSlotDistance(*distances, used, table.band)) {
         options.interface_slots = used;
         char value[48];
         std::snprintf(value, sizeof value, "%.9g", static_cast<double>(*unused));

@@ -105,13 +105,20 @@ TEST_F(SharpViewerTest, RaysThroughABallLeaveAsExactRefractionSays) {
 
 // A ball of constant n uploads its slot's distances alone, one float a voxel (R32F): no n or ∇n
 // (the shader takes the slot's n, CONSTANT_SLOTS) and not the three unused slots' +band
-// (INTERFACES_UNUSED). The picture — radiance and exit directions — is the one of the whole RGBA
-// interfaces texture to the bit: the same march, read from less memory.
+// (INTERFACES_UNUSED) — from the field of one distance per slot voxelize writes and from the four
+// distances and zero ∇n of volumes written before. The picture — radiance and exit directions — is
+// the one of the whole RGBA interfaces texture to the bit: the same march, read from less memory.
 TEST_F(SharpViewerTest, AVolumeOfConstantNUploadsItsUsedDistancesAlone) {
   const Volume lean = sharpVolume("procedural:sphere,r=0.5,ior=1.5", 48, box({-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6}));
-  // The same with one unused distance off the format's +band (a hand-made file): the unused slots
-  // are no longer one constant, so all four distances are uploaded.
-  Volume whole = lean;
+  ASSERT_EQ(lean.fields.at("interfaces").components, 1);
+  ASSERT_FALSE(lean.has("ior_grad"));
+  // The format before: four distances (the unused +band) and a zero ∇n.
+  Volume four = lean;
+  four.fields.at("interfaces") = fourSlotDistances(lean.fields.at("interfaces"), interfaceTable(lean).band);
+  four.addField("ior_grad", 3);
+  // That with one unused distance off the format's +band (a hand-made file): the unused slots are
+  // no longer one constant, so all four distances are uploaded.
+  Volume whole = four;
   Field& d = whole.fields.at("interfaces");
   d.voxel(0)[3] *= 2.0f;  // a corner voxel, far from the ball: the march never reads it
   const std::size_t voxels = lean.grid.count();
@@ -119,21 +126,24 @@ TEST_F(SharpViewerTest, AVolumeOfConstantNUploadsItsUsedDistancesAlone) {
   for (RenderOutput output : {RenderOutput::Radiance, RenderOutput::ExitDirection}) {
     RenderSettings settings;
     settings.output = output;
-    SceneRenderer lean_renderer(*shaders_, oneObject(lean), settings);
     SceneRenderer whole_renderer(*shaders_, oneObject(whole), settings);
-    // Leaving n and ∇n in (or uploading all four distances) fails these.
-    EXPECT_EQ(lean_renderer.volumeTextureBytes(), voxels * sizeof(float));
     EXPECT_EQ(whole_renderer.volumeTextureBytes(), voxels * 4 * sizeof(float));
-    const Image a = lean_renderer.render(camera, {40, 40});
     const Image b = whole_renderer.render(camera, {40, 40});
-    ASSERT_EQ(a.pixels.size(), b.pixels.size());
-    int differing = 0, lit = 0;
-    for (std::size_t i = 0; i < a.pixels.size(); ++i) {
-      differing += a.pixels[i] != b.pixels[i] ? 1 : 0;
-      lit += a.pixels[i] != 0.0f ? 1 : 0;
+    const Volume* forms[] = {&lean, &four};
+    for (const Volume* v : forms) {
+      SceneRenderer renderer(*shaders_, oneObject(*v), settings);
+      // Leaving n and ∇n in (or uploading all four distances) fails this.
+      EXPECT_EQ(renderer.volumeTextureBytes(), voxels * sizeof(float));
+      const Image a = renderer.render(camera, {40, 40});
+      ASSERT_EQ(a.pixels.size(), b.pixels.size());
+      int differing = 0, lit = 0;
+      for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+        differing += a.pixels[i] != b.pixels[i] ? 1 : 0;
+        lit += a.pixels[i] != 0.0f ? 1 : 0;
+      }
+      EXPECT_EQ(differing, 0) << "output " << static_cast<int>(output) << (v == &lean ? ", one distance" : ", four");
+      EXPECT_GT(lit, 400);  // the ball and the sky are there
     }
-    EXPECT_EQ(differing, 0) << "output " << static_cast<int>(output);
-    EXPECT_GT(lit, 400);  // the ball and the sky are there
   }
 }
 
@@ -141,8 +151,10 @@ TEST_F(SharpViewerTest, AVolumeOfConstantNUploadsItsUsedDistancesAlone) {
 // the picture is the one of the volume read whole, to the bit; a graded material's ∇n is read.
 TEST_F(SharpViewerTest, AHeadlessRenderLeavesAConstantNVolumesGradientUnread) {
   test_support::TempDir dir;
-  writeVolume(sharpVolume("procedural:sphere,r=0.5,ior=1.5", 40, box({-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6})),
-              dir / "ball.vol.json");
+  // With its ∇n (0 throughout), as volumes were written before voxelize left it out.
+  Volume ball = sharpVolume("procedural:sphere,r=0.5,ior=1.5", 40, box({-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6}));
+  ball.addField("ior_grad", 3);
+  writeVolume(ball, dir / "ball.vol.json");
   SceneLoadOptions lean_options;
   lean_options.leave_constant_gradient_unread = true;
   LoadedScene whole = loadScene(dir / "ball.vol.json"), lean = loadScene(dir / "ball.vol.json", lean_options);
@@ -165,8 +177,19 @@ TEST_F(SharpViewerTest, AHeadlessRenderLeavesAConstantNVolumesGradientUnread) {
   nlohmann::json table = graded.metadata.at("interfaces");
   table["slots"][0]["graded"] = true;
   graded.metadata["interfaces"] = table;
+  writeVolume(graded, dir / "graded.vol.json");  // without ∇n, which a graded material needs
+  EXPECT_CONTAINS(test_support::inputErrorOf([&] { loadScene(dir / "graded.vol.json", lean_options); }), "ior_grad");
+  graded.addField("ior_grad", 3);
   writeVolume(graded, dir / "graded.vol.json");
   EXPECT_TRUE(loadScene(dir / "graded.vol.json", lean_options).objects[0].volume.has("ior_grad"));
+  // As voxelize writes it now: no ∇n to leave unread, the same picture.
+  writeVolume(sharpVolume("procedural:sphere,r=0.5,ior=1.5", 40, box({-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6})),
+              dir / "lean.vol.json");
+  LoadedScene now = loadScene(dir / "lean.vol.json", lean_options);
+  EXPECT_FALSE(now.objects[0].volume.has("ior_grad") || now.objects[0].volume.unread_fields.count("ior_grad"));
+  now.scene.lights.clear();
+  now.scene.environment.uniform = glm::dvec3(1.0);
+  EXPECT_EQ(SceneRenderer(*shaders_, now, settings).render(camera, {40, 40}).pixels, a.pixels);
 }
 
 // Between sharp surfaces of constant n the march steps as far as the distance field allows

@@ -27,6 +27,47 @@ std::string opticalKey(const Region& r, std::size_t index) {
 
 bool airLike(const Region& r) { return !r.material.opaque && !graded(r) && r.material.ior == 1.0f; }
 
+// ∇n of the graded materials (buildSharpVolume): central differences of n where all three axes'
+// neighbours carry the same graded n, one-sided next to a homogeneous voxel, 0 elsewhere.
+void addGradedGradient(Volume& volume, const GridSpec& grid, std::size_t stride, int slot_count,
+                       const std::vector<int>& graded_region_of_slot, float band_f) {
+  const Field& interfaces = volume.fields.at("interfaces");
+  const Field& ior = volume.fields.at("ior");
+  Field& grad = volume.addField("ior_grad", 3);
+  const glm::dvec3 h = grid.voxelSize();
+  auto gradedAt = [&](int i, int j, int k) {
+    const float* d = &interfaces.data[stride * grid.index(i, j, k)];
+    for (int s = 0; s < slot_count; ++s)
+      if (graded_region_of_slot[static_cast<std::size_t>(s)] >= 0 && d[s] < band_f) return true;
+    return false;
+  };
+  parallelFor(0, grid.dims.z, [&](std::int64_t zz) {
+    const int k = static_cast<int>(zz);
+    for (int j = 0; j < grid.dims.y; ++j)
+      for (int i = 0; i < grid.dims.x; ++i) {
+        if (!gradedAt(i, j, k)) continue;
+        const glm::ivec3 c(i, j, k);
+        float* g = grad.voxel(grid.index(i, j, k));
+        for (int axis = 0; axis < 3; ++axis) {
+          glm::ivec3 lo = c, hi = c;
+          lo[axis] -= 1;
+          hi[axis] += 1;
+          const bool has_lo = lo[axis] >= 0 && gradedAt(lo.x, lo.y, lo.z);
+          const bool has_hi = hi[axis] < grid.dims[axis] && gradedAt(hi.x, hi.y, hi.z);
+          const double n_c = ior.data[grid.index(c.x, c.y, c.z)];
+          double derivative = 0.0;
+          if (has_lo && has_hi)
+            derivative = (ior.data[grid.index(hi.x, hi.y, hi.z)] - ior.data[grid.index(lo.x, lo.y, lo.z)]) / (2.0 * h[axis]);
+          else if (has_hi)
+            derivative = (ior.data[grid.index(hi.x, hi.y, hi.z)] - n_c) / h[axis];
+          else if (has_lo)
+            derivative = (n_c - ior.data[grid.index(lo.x, lo.y, lo.z)]) / h[axis];
+          g[axis] = static_cast<float>(derivative);
+        }
+      }
+  });
+}
+
 }  // namespace
 
 SlotAssignment assignInterfaceSlots(const std::vector<Region>& regions, double band) {
@@ -91,8 +132,9 @@ Volume buildSharpVolume(const std::vector<Region>& regions, const GridSpec& grid
 
   Volume volume = compositeRegions(regions, grid, options);
 
-  // Slot distances: the union (min) of their regions.
-  Field& interfaces = volume.addField("interfaces", 4);
+  // Slot distances: the union (min) of their regions, one per slot (docs/volume-format.md).
+  const std::size_t stride = static_cast<std::size_t>(std::max(slot_count, 1));
+  Field& interfaces = volume.addField("interfaces", static_cast<int>(stride));
   std::fill(interfaces.data.begin(), interfaces.data.end(), static_cast<float>(band));
   std::vector<int> graded_region_of_slot(static_cast<std::size_t>(std::max(slot_count, 0)), -1);
   for (std::size_t i = 0; i < regions.size(); ++i) {
@@ -101,7 +143,7 @@ Volume buildSharpVolume(const std::vector<Region>& regions, const GridSpec& grid
     if (graded(regions[i])) graded_region_of_slot[static_cast<std::size_t>(k)] = static_cast<int>(i);
     const std::vector<float>& d = regions[i].distance;
     for (std::size_t v = 0; v < count; ++v) {
-      float& slot = interfaces.data[4 * v + static_cast<std::size_t>(k)];
+      float& slot = interfaces.data[stride * v + static_cast<std::size_t>(k)];
       slot = std::min(slot, d[v]);
     }
   }
@@ -117,7 +159,7 @@ Volume buildSharpVolume(const std::vector<Region>& regions, const GridSpec& grid
   const float band_f = static_cast<float>(band);
   parallelFor(0, static_cast<std::int64_t>(count), [&](std::int64_t vv) {
     const std::size_t v = static_cast<std::size_t>(vv);
-    const float* d = &interfaces.data[4 * v];
+    const float* d = &interfaces.data[stride * v];
     int label = -1;
     for (int k = 0; k < slot_count; ++k)
       if (d[k] < 0.0f) {
@@ -148,40 +190,12 @@ Volume buildSharpVolume(const std::vector<Region>& regions, const GridSpec& grid
 
   // ∇n: central differences of n where all three axes' neighbours carry the same graded n (inside
   // a graded material or on its continuation), one-sided next to a homogeneous voxel; 0 in the
-  // homogeneous materials and air.
-  Field& grad = volume.addField("ior_grad", 3);
-  const glm::dvec3 h = grid.voxelSize();
-  auto gradedAt = [&](int i, int j, int k) {
-    const float* d = &interfaces.data[4 * grid.index(i, j, k)];
-    for (int s = 0; s < slot_count; ++s)
-      if (graded_region_of_slot[static_cast<std::size_t>(s)] >= 0 && d[s] < band_f) return true;
-    return false;
-  };
-  parallelFor(0, grid.dims.z, [&](std::int64_t zz) {
-    const int k = static_cast<int>(zz);
-    for (int j = 0; j < grid.dims.y; ++j)
-      for (int i = 0; i < grid.dims.x; ++i) {
-        if (!gradedAt(i, j, k)) continue;
-        const glm::ivec3 c(i, j, k);
-        float* g = grad.voxel(grid.index(i, j, k));
-        for (int axis = 0; axis < 3; ++axis) {
-          glm::ivec3 lo = c, hi = c;
-          lo[axis] -= 1;
-          hi[axis] += 1;
-          const bool has_lo = lo[axis] >= 0 && gradedAt(lo.x, lo.y, lo.z);
-          const bool has_hi = hi[axis] < grid.dims[axis] && gradedAt(hi.x, hi.y, hi.z);
-          const double n_c = ior.data[grid.index(c.x, c.y, c.z)];
-          double derivative = 0.0;
-          if (has_lo && has_hi)
-            derivative = (ior.data[grid.index(hi.x, hi.y, hi.z)] - ior.data[grid.index(lo.x, lo.y, lo.z)]) / (2.0 * h[axis]);
-          else if (has_hi)
-            derivative = (ior.data[grid.index(hi.x, hi.y, hi.z)] - n_c) / h[axis];
-          else if (has_lo)
-            derivative = (n_c - ior.data[grid.index(lo.x, lo.y, lo.z)]) / h[axis];
-          g[axis] = static_cast<float>(derivative);
-        }
-      }
-  });
+  // homogeneous materials and air. With slots none of which is graded it is 0 throughout and left
+  // out (core/interfaces.h constantSlots: at 132³ 28 MB that nothing reads); without slots (only
+  // n = 1 objects) there is no table to say so, and the zero field is written.
+  const bool any_graded = std::any_of(graded_region_of_slot.begin(), graded_region_of_slot.end(), [](int r) { return r >= 0; });
+  if (any_graded) addGradedGradient(volume, grid, stride, slot_count, graded_region_of_slot, band_f);
+  else if (slot_count == 0) volume.addField("ior_grad", 3);
 
   if (slot_count > 0) {
     volume.metadata["interfaces"] = slots.table.toJson();
@@ -191,7 +205,8 @@ Volume buildSharpVolume(const std::vector<Region>& regions, const GridSpec& grid
     volume.fields.erase("interfaces");
   }
   volume.metadata["ior_smoothing_sigma_voxels"] = 0.0;
-  volume.metadata["ior_gradient"] = "graded materials only (sharp interfaces)";
+  volume.metadata["ior_gradient"] = slot_count > 0 && !any_graded ? "left out: no graded material (sharp interfaces)"
+                                                                   : "graded materials only (sharp interfaces)";
   return volume;
 }
 

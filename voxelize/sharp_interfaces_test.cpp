@@ -100,18 +100,19 @@ TEST(SharpInterfaces, FieldsAreSharpDistancesAndUnblendedN) {
   const Volume v = buildSharpVolume(regionsOf({"procedural:sphere,r=0.5,ior=1.5"}, g), g, interfaceBand(g));
   const Field& d = v.fields.at("interfaces");
   const Field& n = v.fields.at("ior");
-  const Field& grad = v.fields.at("ior_grad");
+  // One distance per slot; no ∇n, which is 0 throughout without a graded material (constantSlots).
+  ASSERT_EQ(d.components, 1);
+  EXPECT_FALSE(v.has("ior_grad"));
+  EXPECT_EQ(iorGradient(v, interfaceTable(v)), nullptr);
   for (int k = 0; k < 32; ++k)
     for (int j = 0; j < 32; ++j)
       for (int i = 0; i < 32; ++i) {
         const std::size_t at = g.index(i, j, k);
         const double r = glm::length(g.center(i, j, k));
         const double band = interfaceBand(g);
-        // The exact distance of a sphere, within the band; +band beyond; unused slots +band.
+        // The exact distance of a sphere, within the band; +band beyond.
         ASSERT_NEAR(d.voxel(at)[0], std::clamp(r - 0.5, -band, band), 1e-6);
-        ASSERT_FLOAT_EQ(d.voxel(at)[1], static_cast<float>(band));
         ASSERT_FLOAT_EQ(n.data[at], r < 0.5 ? 1.5f : 1.0f);  // no blending at the surface
-        ASSERT_EQ(grad.voxel(at)[0], 0.0f);
       }
   EXPECT_EQ(v.metadata.at("interfaces").at("slots").size(), 1u);
   EXPECT_EQ(v.metadata.at("ior_smoothing_sigma_voxels"), 0.0);
@@ -127,6 +128,8 @@ TEST(SharpInterfaces, ObjectsOfAirMakeAVolumeWithoutInterfaces) {
   EXPECT_FALSE(v.metadata.contains("interfaces"));
   EXPECT_TRUE(interfaceTable(v).empty());  // the reader's view: a volume without sharp interfaces
   for (float n : v.fields.at("ior").data) ASSERT_EQ(n, 1.0f);
+  ASSERT_TRUE(v.has("ior_grad"));  // no table to say ∇n is 0: readers need the field
+  for (float g : v.fields.at("ior_grad").data) ASSERT_EQ(g, 0.0f);
 }
 
 TEST(SharpInterfaces, AGradedLensKeepsItsOwnNAndGradientAcrossTheSurface) {
@@ -134,6 +137,7 @@ TEST(SharpInterfaces, AGradedLensKeepsItsOwnNAndGradientAcrossTheSurface) {
   const Volume v = buildSharpVolume(regionsOf({"procedural:gradient_slab,size=0.8:0.8:0.8,n0=1.3,n1=1.7"}, g), g,
                                     interfaceBand(g));
   ASSERT_TRUE(interfaceTable(v).slots.at(0).graded);
+  EXPECT_EQ(v.fields.at("interfaces").components, 1);
   // n rises by 0.4 over 0.8 along x: ∇n = (0.5, 0, 0) inside and just outside (continued), no jump.
   const Field& grad = v.fields.at("ior_grad");
   for (int i = 2; i < 30; ++i) {
