@@ -71,6 +71,79 @@ bool activeRegion(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi) {
   return true;
 }
 
+namespace {
+
+// The window of voxels along one axis that brick b reads: its kBrickVoxels and kBrickMargin on
+// either side, clamped to the grid ([first, last)).
+void brickWindow(int b, int voxels, int& first, int& last) {
+  first = std::max(b * kBrickVoxels - kBrickMargin, 0);
+  last = std::min(b * kBrickVoxels + kBrickVoxels + kBrickMargin, voxels);
+}
+
+// The least and greatest value of each of `channels` channels (n; σa's three) and whether a voxel
+// breaks homogeneity by itself, over boxes of voxels: structure of arrays, element e's channel c
+// at e·channels + c.
+struct BoxRanges {
+  int channels = 1;
+  std::vector<float> lo, hi;
+  std::vector<std::uint8_t> busy;
+
+  BoxRanges(std::size_t elements, int c)
+      : channels(c), lo(elements * static_cast<std::size_t>(c)), hi(elements * static_cast<std::size_t>(c)), busy(elements) {}
+};
+
+// The least and greatest of each of C channels over `count` elements `step` apart (C floats each)
+// into lo and hi: kept in registers, written once.
+template <int C>
+void rangeOf(const float* lo_in, const float* hi_in, std::size_t step, int count, float* lo, float* hi) {
+  float l[C], u[C];
+  for (int k = 0; k < C; ++k) l[k] = lo_in[k], u[k] = hi_in[k];
+  for (int v = 1; v < count; ++v) {
+    const std::size_t at = static_cast<std::size_t>(v) * step * C;
+    for (int k = 0; k < C; ++k) {
+      l[k] = std::min(l[k], lo_in[at + static_cast<std::size_t>(k)]);
+      u[k] = std::max(u[k], hi_in[at + static_cast<std::size_t>(k)]);
+    }
+  }
+  for (int k = 0; k < C; ++k) lo[k] = l[k], hi[k] = u[k];
+}
+
+void rangeOf(int channels, const float* lo_in, const float* hi_in, std::size_t step, int count, float* lo, float* hi) {
+  if (channels == 1) rangeOf<1>(lo_in, hi_in, step, count, lo, hi);
+  else rangeOf<4>(lo_in, hi_in, step, count, lo, hi);
+}
+
+// `in` (dims) reduced along `axis` over each brick's window: dims[axis] becomes the brick count.
+BoxRanges reduceAlong(const BoxRanges& in, glm::ivec3 dims, int axis, glm::ivec3& out_dims) {
+  out_dims = dims;
+  out_dims[axis] = (dims[axis] + kBrickVoxels - 1) / kBrickVoxels;
+  const int c = in.channels;
+  BoxRanges out(static_cast<std::size_t>(out_dims.x) * out_dims.y * out_dims.z, c);
+  const std::size_t stride[3] = {1, static_cast<std::size_t>(dims.x), static_cast<std::size_t>(dims.x) * dims.y};
+  parallelFor(0, out_dims.z, [&](std::int64_t z) {
+    const float* in_lo = in.lo.data();
+    const float* in_hi = in.hi.data();
+    const std::uint8_t* in_busy = in.busy.data();
+    const std::size_t step = stride[axis];
+    for (int y = 0; y < out_dims.y; ++y)
+      for (int x = 0; x < out_dims.x; ++x) {
+        glm::ivec3 o(x, y, static_cast<int>(z));
+        int first = 0, last = 0;
+        brickWindow(o[axis], dims[axis], first, last);
+        const std::size_t e = (static_cast<std::size_t>(o.z) * out_dims.y + static_cast<std::size_t>(o.y)) * out_dims.x + static_cast<std::size_t>(o.x);
+        o[axis] = first;
+        const std::size_t base = (static_cast<std::size_t>(o.z) * dims.y + static_cast<std::size_t>(o.y)) * dims.x + static_cast<std::size_t>(o.x);
+        rangeOf(c, in_lo + base * c, in_hi + base * c, step, last - first, &out.lo[e * c], &out.hi[e * c]);
+        std::uint8_t busy = 0;
+        for (int v = 0; v < last - first; ++v) busy |= in_busy[base + static_cast<std::size_t>(v) * step];
+        out.busy[e] = busy;
+      }
+  });
+  return out;
+}
+
+}  // namespace
+
 std::vector<float> homogeneousBricks(const Volume& volume, glm::ivec3& brick_dims) {
   const GridSpec& grid = volume.grid;
   const glm::ivec3 dims = grid.dims;
@@ -79,42 +152,69 @@ std::vector<float> homogeneousBricks(const Volume& volume, glm::ivec3& brick_dim
   const MediumFields f(volume);
   const Field *ior = f.ior, *grad = f.grad, *sigma = f.sigma, *emission = f.emission, *scatter = f.scatter,
               *opaque = f.opaque;
-  // Per voxel: does it break homogeneity by itself (∇n, emission, scattering, opaque)?
-  std::vector<unsigned char> busy(grid.count(), 0);
-  parallelFor(
-      0, static_cast<std::int64_t>(grid.count()),
-      [&](std::int64_t i64) {
-        const std::size_t i = static_cast<std::size_t>(i64);
-        const float* g = grad ? grad->voxel(i) : nullptr;  // ∇n left unread: 0 (constant-n materials)
+  // A brick is homogeneous when no voxel of its box (the brick and its margin) is busy — breaks
+  // homogeneity by itself with ∇n, emission, scattering or an opaque embedding — and n and each σa
+  // differ from those of the box's first voxel by no more than the tolerances. The box is a product
+  // of three windows, so the least and greatest n and σa over it come one axis at a time: along x
+  // straight from the fields, then along y and z over the shrinking arrays (each voxel is read by
+  // two windows of a row, not by the (4 + 2·2)³ / 4³ = 8 boxes that hold it). Rounding is monotonic,
+  // so the largest |v − first| is that of the least or greatest v: the same bricks as comparing
+  // every voxel of every box.
+  const int channels = sigma ? 4 : 1;
+  const bool any_busy = grad || emission || scatter || opaque;  // ∇n left unread or out: 0
+  glm::ivec3 row_dims(brick_dims.x, dims.y, dims.z);
+  BoxRanges rows(static_cast<std::size_t>(row_dims.x) * row_dims.y * row_dims.z, channels);
+  parallelFor(0, dims.z, [&](std::int64_t z) {
+    std::vector<float> values(static_cast<std::size_t>(dims.x) * channels);  // one row, channels interleaved
+    std::vector<std::uint8_t> busy(static_cast<std::size_t>(dims.x), 0);
+    for (int y = 0; y < dims.y; ++y) {
+      const std::size_t row = grid.index(0, y, static_cast<int>(z));
+      for (int x = 0; x < dims.x; ++x) {
+        const std::size_t i = row + static_cast<std::size_t>(x);
+        float* v = &values[static_cast<std::size_t>(x) * channels];
+        v[0] = ior->data[i];
+        if (sigma) std::copy_n(sigma->voxel(i), 3, v + 1);
+        if (!any_busy) continue;
+        const float* g = grad ? grad->voxel(i) : nullptr;
         bool b = g && (std::abs(g[0]) + std::abs(g[1]) + std::abs(g[2])) * h > 1e-4;
         if (emission) b = b || emission->voxel(i)[0] > 0 || emission->voxel(i)[1] > 0 || emission->voxel(i)[2] > 0;
         if (scatter) b = b || scatter->voxel(i)[0] > 0;
         if (opaque) b = b || opaque->voxel(i)[3] > 0;
-        busy[i] = b;
-      },
-      1 << 15);
+        busy[static_cast<std::size_t>(x)] = b;
+      }
+      for (int bx = 0; bx < brick_dims.x; ++bx) {
+        int first = 0, last = 0;
+        brickWindow(bx, dims.x, first, last);
+        const std::size_t e = (static_cast<std::size_t>(z) * dims.y + static_cast<std::size_t>(y)) * brick_dims.x + bx;
+        const float* v = &values[static_cast<std::size_t>(first) * channels];
+        rangeOf(channels, v, v, 1, last - first, &rows.lo[e * channels], &rows.hi[e * channels]);
+        std::uint8_t any = 0;
+        for (int x = first; x < last; ++x) any |= busy[static_cast<std::size_t>(x)];
+        rows.busy[e] = any;
+      }
+    }
+  });
+  glm::ivec3 column_dims, brick_check;
+  const BoxRanges columns = reduceAlong(rows, row_dims, 1, column_dims);
+  const BoxRanges boxes = reduceAlong(columns, column_dims, 2, brick_check);
   std::vector<float> bricks(static_cast<std::size_t>(brick_dims.x) * brick_dims.y * brick_dims.z, 0.0f);
-  parallelFor(0, brick_dims.z, [&](std::int64_t bz64) {
-    const int bz = static_cast<int>(bz64);
+  for (int bz = 0; bz < brick_dims.z; ++bz)
     for (int by = 0; by < brick_dims.y; ++by)
       for (int bx = 0; bx < brick_dims.x; ++bx) {
+        const std::size_t e = (static_cast<std::size_t>(bz) * brick_dims.y + by) * brick_dims.x + bx;
         const glm::ivec3 lo = glm::max(glm::ivec3(bx, by, bz) * kBrickVoxels - kBrickMargin, glm::ivec3(0));
-        const glm::ivec3 hi = glm::min(glm::ivec3(bx, by, bz) * kBrickVoxels + kBrickVoxels + kBrickMargin, dims) - 1;
         const std::size_t first = grid.index(lo.x, lo.y, lo.z);
-        bool homogeneous = true;
-        for (int k = lo.z; k <= hi.z && homogeneous; ++k)
-          for (int j = lo.y; j <= hi.y && homogeneous; ++j)
-            for (int i = lo.x; i <= hi.x && homogeneous; ++i) {
-              const std::size_t v = grid.index(i, j, k);
-              if (busy[v] || std::abs(ior->data[v] - ior->data[first]) > 1e-4f) homogeneous = false;
-              if (sigma)
-                for (int c = 0; c < 3; ++c)
-                  if (std::abs(sigma->voxel(v)[c] - sigma->voxel(first)[c]) > 1e-6f * (1.0f + sigma->voxel(first)[c]))
-                    homogeneous = false;
-            }
-        bricks[(static_cast<std::size_t>(bz) * brick_dims.y + by) * brick_dims.x + bx] = homogeneous ? 1.0f : 0.0f;
+        bool homogeneous = boxes.busy[e] == 0;
+        const float* vlo = &boxes.lo[e * channels];
+        const float* vhi = &boxes.hi[e * channels];
+        const float n0 = ior->data[first];
+        if (std::abs(vhi[0] - n0) > 1e-4f || std::abs(vlo[0] - n0) > 1e-4f) homogeneous = false;
+        for (int c = 1; c < channels; ++c) {
+          const float s0 = sigma->voxel(first)[c - 1];
+          if (std::abs(vhi[c] - s0) > 1e-6f * (1.0f + s0) || std::abs(vlo[c] - s0) > 1e-6f * (1.0f + s0)) homogeneous = false;
+        }
+        bricks[e] = homogeneous ? 1.0f : 0.0f;
       }
-  });
   return bricks;
 }
 

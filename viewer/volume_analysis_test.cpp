@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -135,6 +136,80 @@ TEST(HomogeneousBricks, ChangesOfIndexOrAbsorptionAndMediaBreakHomogeneity) {
     EXPECT_EQ(brick(bricks, dims, 1, 0, 0), 0.0f) << name;
   }
 }
+
+// Each brick read voxel by voxel over its box (the brick and its margin): the definition the
+// separable ranges of homogeneousBricks must reproduce exactly.
+std::vector<float> bricksVoxelByVoxel(const Volume& v) {
+  const glm::ivec3 dims = v.grid.dims, bd = (dims + kBrickVoxels - 1) / kBrickVoxels;
+  const Field& n = v.fields.at("ior");
+  const Field* g = v.find("ior_grad");
+  const Field* sigma = v.find("sigma_a");
+  const Field* emission = v.find("emission");
+  std::vector<float> out(static_cast<std::size_t>(bd.x) * bd.y * bd.z);
+  for (int bz = 0; bz < bd.z; ++bz)
+    for (int by = 0; by < bd.y; ++by)
+      for (int bx = 0; bx < bd.x; ++bx) {
+        const glm::ivec3 lo = glm::max(glm::ivec3(bx, by, bz) * kBrickVoxels - kBrickMargin, glm::ivec3(0));
+        const glm::ivec3 hi = glm::min(glm::ivec3(bx, by, bz) * kBrickVoxels + kBrickVoxels + kBrickMargin, dims);
+        const std::size_t first = v.grid.index(lo.x, lo.y, lo.z);
+        bool homogeneous = true;
+        for (int k = lo.z; k < hi.z; ++k)
+          for (int j = lo.y; j < hi.y; ++j)
+            for (int i = lo.x; i < hi.x; ++i) {
+              const std::size_t at = v.grid.index(i, j, k);
+              if (std::abs(n.data[at] - n.data[first]) > 1e-4f) homogeneous = false;
+              if (g && (std::abs(g->voxel(at)[0]) + std::abs(g->voxel(at)[1]) + std::abs(g->voxel(at)[2])) > 1e-4) homogeneous = false;
+              if (emission && emission->voxel(at)[1] > 0) homogeneous = false;
+              if (sigma)
+                for (int c = 0; c < 3; ++c)
+                  if (std::abs(sigma->voxel(at)[c] - sigma->voxel(first)[c]) > 1e-6f * (1.0f + sigma->voxel(first)[c]))
+                    homogeneous = false;
+            }
+        out[(static_cast<std::size_t>(bz) * bd.y + by) * bd.x + bx] = homogeneous ? 1.0f : 0.0f;
+      }
+  return out;
+}
+
+// Random volumes (grids that are and are not multiples of the brick, n in plateaus with changes at
+// and just around the tolerance, σa likewise, a few voxels of ∇n and of emission): the bricks are
+// those of reading every voxel of every box.
+TEST(HomogeneousBricks, TheSeparableRangesAreThoseOfEveryVoxel) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  int homogeneous = 0, marched = 0;
+  for (const glm::ivec3 dims : {glm::ivec3(17, 9, 12), glm::ivec3(16, 16, 8), glm::ivec3(5, 23, 3)}) {
+    for (int variant = 0; variant < 4; ++variant) {
+      Volume v = air(dims);
+      if (variant >= 2) v.addField("sigma_a", 3);
+      if (variant == 3) v.addField("emission", 3);
+      for (std::size_t i = 0; i < v.grid.count(); ++i) {
+        const float r = u(rng);
+        // Mostly 1.5; some voxels off by 0.5e-4 (within the tolerance), fewer by 1.5e-4 (beyond) or a step.
+        v.fields.at("ior").data[i] = r < 0.98f ? 1.5f : r < 0.999f ? 1.50005f : r < 0.9995f ? 1.50015f : 1.33f;
+        if (u(rng) < 0.0005f) v.fields.at("ior_grad").voxel(i)[u(rng) < 0.5f ? 0 : 2] = 0.3f;
+        if (variant >= 2) {
+          float* s = v.fields.at("sigma_a").voxel(i);
+          s[0] = 2.0f;
+          s[1] = u(rng) < 0.0005f ? 2.0f : 0.5f;
+          s[2] = u(rng) < 0.01f ? 0.5f + 1e-7f : 0.5f;  // within 1e-6·(1 + σa)
+        }
+        if (variant == 3 && u(rng) < 0.0005f) v.fields.at("emission").voxel(i)[1] = 1.0f;
+      }
+      glm::ivec3 bd;
+      const std::vector<float> bricks = homogeneousBricks(v, bd);
+      EXPECT_EQ(bd, (dims + kBrickVoxels - 1) / kBrickVoxels);
+      const std::vector<float> want = bricksVoxelByVoxel(v);
+      ASSERT_EQ(bricks.size(), want.size());
+      for (std::size_t b = 0; b < want.size(); ++b) {
+        EXPECT_EQ(bricks[b], want[b]) << "brick " << b << ", grid " << dims.x << "x" << dims.y << "x" << dims.z << ", variant " << variant;
+        (want[b] != 0.0f ? homogeneous : marched) += 1;
+      }
+    }
+  }
+  EXPECT_GT(homogeneous, 20);  // both kinds are there to compare
+  EXPECT_GT(marched, 20);
+}
+
 
 TEST(MaterialTouchesBox, OnlyWhereNDiffersFromOneOnAFace) {
   Volume v = air({6, 6, 6});
