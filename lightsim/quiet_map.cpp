@@ -1,6 +1,7 @@
 #include "lightsim/quiet_map.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "core/parallel.h"
@@ -56,7 +57,12 @@ QuietMap::QuietMap(const GridSpec& grid, const FieldViews& fields, const Interfa
   auto signature = [&](std::size_t v) {
     Signature s;
     bool graded = true;  // the n and ∇n fields are what a sample returns
-    if (sharp) {
+    if (sharp && fields.slot_signs) {
+      const int bits = fields.slot_signs[v];
+      s.signs = bits & 15;
+      s.noisy = (bits >> 4) != 0;
+      graded = s.signs != 0 && table.slots[static_cast<std::size_t>(std::countr_zero(static_cast<unsigned>(s.signs)))].graded;
+    } else if (sharp) {
       const float* dist = fields.distances + v * fields.distances_stride;
       int material = -1;
       for (int k = 0; k < slots; ++k) {
@@ -82,6 +88,34 @@ QuietMap::QuietMap(const GridSpec& grid, const FieldViews& fields, const Interfa
   };
   std::vector<std::uint8_t> flag(static_cast<std::size_t>(bricks_.x) * bricks_.y * bricks_.z, 0);
   auto brick = [&](int x, int y, int z) -> std::uint8_t& { return brickFlag(flag, x, y, z); };
+  if (sharp && fields.slot_signs && !fields.sigma_a && !graded_slot) {
+    // Sharp constant-n materials without σa: a voxel's signature is its signs alone, noisy where a
+    // distance is 0 (what `signature` gives, from one byte a voxel).
+    const std::uint8_t* signs = fields.slot_signs;
+    parallelFor(0, bricks_.z, [&](std::int64_t layer) {
+      const int z0 = static_cast<int>(layer) * brick_, z1 = std::min(d.z, z0 + brick_);
+      const std::size_t sy = static_cast<std::size_t>(d.x), sz = sy * static_cast<std::size_t>(d.y);
+      for (int z = z0; z < z1; ++z)
+        for (int y = 0; y < d.y; ++y) {
+          const std::size_t row = grid.index(0, y, z);
+          for (int x = 0; x < d.x; ++x) {
+            const std::size_t i = row + static_cast<std::size_t>(x);
+            const int s = signs[i] & 15;
+            bool noisy = (signs[i] >> 4) != 0;
+            if (x + 1 < d.x && (signs[i + 1] & 15) != s) noisy = true, brick(x + 1, y, z) = 1;
+            if (y + 1 < d.y && (signs[i + sy] & 15) != s) noisy = true, brick(x, y + 1, z) = 1;
+            if (z + 1 < d.z && (signs[i + sz] & 15) != s) {
+              noisy = true;
+              if (z + 1 < z1) brick(x, y, z + 1) = 1;  // in this layer
+            }
+            if (z == z0 && z > 0 && (signs[i - sz] & 15) != s) noisy = true;
+            if (noisy) brick(x, y, z) = 1;
+          }
+        }
+    });
+    buildTable(flag);
+    return;
+  }
   // By layers of bricks in parallel, each layer writing only its own bricks: a pair of voxels that
   // differ across two layers is flagged by each layer on its side (the upper one compares its
   // lowest voxels with those below).

@@ -51,6 +51,9 @@ class QuietMap {
     std::size_t distances_stride = 4;
     const float* sigma_a = nullptr;    // σa (3 floats), every sigma_stride floats; null: none
     std::size_t sigma_stride = 3;
+    // The distances' signs a voxel, if known (VolumeSampler): bit k slot k's distance < 0, bit 4 + k
+    // it is 0; read instead of the distances.
+    const std::uint8_t* slot_signs = nullptr;
   };
   QuietMap(const GridSpec& grid, const FieldViews& fields, const InterfaceTable& table);
 

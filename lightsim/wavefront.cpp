@@ -148,6 +148,7 @@ VolumeSampler::VolumeSampler(const Volume& volume)
     });
   }
   const Field* d = nullptr;
+  std::vector<std::uint8_t> slot_signs;  // while the tables are built
   if (!table_.empty()) {
     d = volume.find("interfaces");  // one distance per slot, or four (interfaceTable checked which)
     const int used = slotCount();
@@ -169,25 +170,47 @@ VolumeSampler::VolumeSampler(const Volume& volume)
         }
       });
     }
-    // Each cell's material where its eight taps agree (materialAt).
+    // Each voxel's signs once (bit k: slot k's distance < 0; bit 4 + k: it is 0), for the cells'
+    // materials here and the quiet bricks below, which compare them between neighbours.
+    slot_signs = std::vector<std::uint8_t>(n);
+    forChunks([&](std::size_t begin, std::size_t end) {
+      const float* data = d->data.data();
+      const std::size_t stride = static_cast<std::size_t>(d->components);
+      for (std::size_t i = begin; i < end; ++i) {
+        std::uint8_t bits = 0;
+        for (int k = 0; k < used; ++k) {
+          const float v = data[i * stride + static_cast<std::size_t>(k)];
+          bits |= static_cast<std::uint8_t>((v < 0.0f ? 1 : 0) << k | (v == 0.0f ? 1 : 0) << (4 + k));
+        }
+        slot_signs[i] = bits;
+      }
+    });
+    // Each cell's material where its eight taps agree (materialAt): a slot's distance < 0 at every
+    // tap or at none.
     const glm::ivec3 dims = grid_.dims;
+    const int used_bits = (1 << used) - 1;
     cell_material_.assign(n, kMixedCell);
     parallelFor(0, dims.z, [&](std::int64_t z64) {
       const int z = static_cast<int>(z64), z1 = std::min(z + 1, dims.z - 1);
       for (int y = 0; y < dims.y; ++y) {
         const int y1 = std::min(y + 1, dims.y - 1);
+        const std::uint8_t* rows[4] = {&slot_signs[grid_.index(0, y, z)], &slot_signs[grid_.index(0, y1, z)],
+                                       &slot_signs[grid_.index(0, y, z1)], &slot_signs[grid_.index(0, y1, z1)]};
+        std::int8_t* out = &cell_material_[grid_.index(0, y, z)];
         for (int x = 0; x < dims.x; ++x) {
           const int x1 = std::min(x + 1, dims.x - 1);
           int inside = 0, outside = 0;  // bit k: slot k's distance < 0 (≥ 0) at some tap
-          for (int t = 0; t < 8; ++t) {
-            const float* v = d->voxel(grid_.index(t & 1 ? x1 : x, t & 2 ? y1 : y, t & 4 ? z1 : z));
-            for (int k = 0; k < used; ++k) (v[k] < 0.0f ? inside : outside) |= 1 << k;
+          for (const std::uint8_t* row : rows) {
+            inside |= row[x] | row[x1];
+            outside |= ~row[x] | ~row[x1];
           }
+          inside &= used_bits;
+          outside &= used_bits;
           if ((inside & outside) != 0) continue;  // a slot changes sign in the cell
           std::int8_t material = -1;
           for (int k = 0; k < used && material < 0; ++k)
             if (inside & (1 << k)) material = static_cast<std::int8_t>(k);
-          cell_material_[grid_.index(x, y, z)] = material;
+          out[x] = material;
         }
       }
     });
@@ -209,6 +232,7 @@ VolumeSampler::VolumeSampler(const Volume& volume)
   if (d) {
     views.distances = d->data.data();
     views.distances_stride = static_cast<std::size_t>(d->components);
+    views.slot_signs = slot_signs.data();
   }
   if (!sigma_a_.empty()) views.sigma_a = &sigma_a_[0].x;
   quiet_ = QuietMap(grid_, views, table_);
