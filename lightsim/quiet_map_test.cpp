@@ -165,45 +165,63 @@ TEST(QuietMap, TheNoisyBricksAreThoseANoisyVoxelOrADifferingFaceNeighbourMakes) 
   InterfaceTable table;
   table.slots.resize(2);
   table.band = 0.04;
-  const QuietMap map(grid, ior_grad, distances, table, sigma);
-  ASSERT_EQ(map.brickVoxels(), 2);
-  // The plain scan.
-  auto signature = [&](std::size_t i) {
-    return std::tuple<bool, bool, float>(distances[i].x < 0.0f, distances[i].y < 0.0f, sigma[i].x);
-  };
-  const glm::ivec3 bricks = map.bricks();
-  std::vector<std::uint8_t> noisy(static_cast<std::size_t>(bricks.x) * bricks.y * bricks.z, 0);
-  auto flag = [&](int x, int y, int z) { noisy[static_cast<std::size_t>(x / 2 + bricks.x * (y / 2 + bricks.y * (z / 2)))] = 1; };
-  for (int z = 0; z < 23; ++z)
-    for (int y = 0; y < 9; ++y)
-      for (int x = 0; x < 170; ++x) {
-        const std::size_t i = grid.index(x, y, z);
-        if (distances[i].x == 0.0f || distances[i].y == 0.0f) flag(x, y, z);
-        const int nx[6] = {x - 1, x + 1, x, x, x, x}, ny[6] = {y, y, y - 1, y + 1, y, y}, nz[6] = {z, z, z, z, z - 1, z + 1};
-        for (int a = 0; a < 6; ++a) {
-          if (nx[a] < 0 || ny[a] < 0 || nz[a] < 0 || nx[a] >= 170 || ny[a] >= 9 || nz[a] >= 23) continue;
-          if (signature(grid.index(nx[a], ny[a], nz[a])) != signature(i)) flag(x, y, z);
+  // The distances' signs a voxel, as VolumeSampler passes them (bit k: < 0, bit 4 + k: = 0).
+  std::vector<std::uint8_t> signs(n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 2; ++k)
+      signs[i] |= static_cast<std::uint8_t>((distances[i][k] < 0.0f ? 1 : 0) << k | (distances[i][k] == 0.0f ? 1 : 0) << (4 + k));
+  // From the vectors, from views with the signs, and from the signs without σa (the constant-n
+  // materials' own scan): each against the plain scan below.
+  for (int form = 0; form < 3; ++form) {
+    const bool with_sigma = form < 2;
+    QuietMap::FieldViews views;
+    views.ior = &ior_grad[0].x;
+    views.ior_stride = 4;
+    views.grad = &ior_grad[0].y;
+    views.grad_stride = 4;
+    views.distances = &distances[0].x;
+    views.slot_signs = signs.data();
+    if (with_sigma) views.sigma_a = &sigma[0].x;
+    const QuietMap map = form == 0 ? QuietMap(grid, ior_grad, distances, table, sigma) : QuietMap(grid, views, table);
+    ASSERT_EQ(map.brickVoxels(), 2);
+    // The plain scan.
+    auto signature = [&](std::size_t i) {
+      return std::tuple<bool, bool, float>(distances[i].x < 0.0f, distances[i].y < 0.0f, with_sigma ? sigma[i].x : 0.0f);
+    };
+    const glm::ivec3 bricks = map.bricks();
+    std::vector<std::uint8_t> noisy(static_cast<std::size_t>(bricks.x) * bricks.y * bricks.z, 0);
+    auto flag = [&](int x, int y, int z) { noisy[static_cast<std::size_t>(x / 2 + bricks.x * (y / 2 + bricks.y * (z / 2)))] = 1; };
+    for (int z = 0; z < 23; ++z)
+      for (int y = 0; y < 9; ++y)
+        for (int x = 0; x < 170; ++x) {
+          const std::size_t i = grid.index(x, y, z);
+          if (distances[i].x == 0.0f || distances[i].y == 0.0f) flag(x, y, z);
+          const int nx[6] = {x - 1, x + 1, x, x, x, x}, ny[6] = {y, y, y - 1, y + 1, y, y}, nz[6] = {z, z, z, z, z - 1, z + 1};
+          for (int a = 0; a < 6; ++a) {
+            if (nx[a] < 0 || ny[a] < 0 || nz[a] < 0 || nx[a] >= 170 || ny[a] >= 9 || nz[a] >= 23) continue;
+            if (signature(grid.index(nx[a], ny[a], nz[a])) != signature(i)) flag(x, y, z);
+          }
         }
-      }
-  // The table's count in each single brick.
-  const std::vector<std::uint32_t>& sat = map.table();
-  auto at = [&](int i, int j, int k) {
-    return static_cast<std::int64_t>(sat[static_cast<std::size_t>(i) + static_cast<std::size_t>(bricks.x + 1) *
-                                          (static_cast<std::size_t>(j) + static_cast<std::size_t>(bricks.y + 1) * static_cast<std::size_t>(k))]);
-  };
-  int checked_noisy = 0;
-  for (int k = 0; k < bricks.z; ++k)
-    for (int j = 0; j < bricks.y; ++j)
-      for (int i = 0; i < bricks.x; ++i) {
-        const std::int64_t count = at(i + 1, j + 1, k + 1) - at(i, j + 1, k + 1) - at(i + 1, j, k + 1) - at(i + 1, j + 1, k) +
-                                   at(i, j, k + 1) + at(i, j + 1, k) + at(i + 1, j, k) - at(i, j, k);
-        const bool expected = noisy[static_cast<std::size_t>(i + bricks.x * (j + bricks.y * k))] != 0;
-        ASSERT_EQ(count, expected ? 1 : 0) << "brick " << i << " " << j << " " << k;
-        checked_noisy += expected ? 1 : 0;
-      }
-  EXPECT_EQ(static_cast<std::size_t>(checked_noisy), map.noisyBricks());
-  EXPECT_GT(checked_noisy, 100);
-  EXPECT_LT(static_cast<std::size_t>(checked_noisy), noisy.size() / 2);
+    // The table's count in each single brick.
+    const std::vector<std::uint32_t>& sat = map.table();
+    auto at = [&](int i, int j, int k) {
+      return static_cast<std::int64_t>(sat[static_cast<std::size_t>(i) + static_cast<std::size_t>(bricks.x + 1) *
+                                            (static_cast<std::size_t>(j) + static_cast<std::size_t>(bricks.y + 1) * static_cast<std::size_t>(k))]);
+    };
+    int checked_noisy = 0;
+    for (int k = 0; k < bricks.z; ++k)
+      for (int j = 0; j < bricks.y; ++j)
+        for (int i = 0; i < bricks.x; ++i) {
+          const std::int64_t count = at(i + 1, j + 1, k + 1) - at(i, j + 1, k + 1) - at(i + 1, j, k + 1) - at(i + 1, j + 1, k) +
+                                     at(i, j, k + 1) + at(i, j + 1, k) + at(i + 1, j, k) - at(i, j, k);
+          const bool expected = noisy[static_cast<std::size_t>(i + bricks.x * (j + bricks.y * k))] != 0;
+          ASSERT_EQ(count, expected ? 1 : 0) << "brick " << i << " " << j << " " << k;
+          checked_noisy += expected ? 1 : 0;
+        }
+    EXPECT_EQ(static_cast<std::size_t>(checked_noisy), map.noisyBricks());
+    EXPECT_GT(checked_noisy, 100);
+    EXPECT_LT(static_cast<std::size_t>(checked_noisy), noisy.size() / 2);
+  }
 }
 
 TEST(QuietMap, FlaggedVoxelsMakeTheBoxesWhoseSamplesTouchThemNoisy) {
