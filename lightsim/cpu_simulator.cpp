@@ -227,6 +227,55 @@ bool willTear(const Patch& patch, int met_mask, const VolumeSampler& sampler, do
   return false;
 }
 
+// Straight steps merged (ALGORITHM.md "Free flight"): where the quiet map refuses even a flight's
+// first piece (a patch within a brick or two of an interface) and every ray is straight between
+// interfaces (straight steps apply: sharp materials of constant n), the ordinary straight steps the
+// patch would take are looked at ahead. A corner's straight step crosses nothing when it ends in its
+// own material (findInterface asks no more), so as long as every corner ends each of the next k
+// steps in its own material, those k steps move the corners exactly as one step of k times the time
+// does, and the steps between have nothing to do (no crossing, no tear; no split within t_max, the
+// edges' bound, and none for a patch that is due to split now; a Fresnel, absorption or exit test
+// only where they would anyway). The steps' ends
+// are asked for their material one by one, except along pieces of the path the quiet map finds
+// quiet (no interface there: every end in it is in the corners' material), and no further once the
+// midpoint has left the propagation box (the patch then exits). The patch flies those k steps at
+// once (k ≥ 2, at most kMaxMergedSteps); 0: it takes its ordinary step.
+constexpr int kMaxMergedSteps = 64;
+template <typename QuietBetween>
+double mergedStepsTime(const Patch& patch, const std::array<glm::dvec3, 4>& v, const StepContext& ctx, double t_max,
+                       bool split_due, QuietBetween&& quiet_between) {
+  const VolumeSampler& sampler = *ctx.sampler;
+  if (!ctx.options->merge_straight_steps || !(ctx.step_dt > ctx.dt) || patch.reflected != 0 || split_due ||
+      (sampler.hasAbsorption() && !sampler.absorptionPerMaterial()))
+    return 0.0;
+  const double step = patch.bounce > 0 ? ctx.reflected_step_dt : ctx.step_dt;
+  const int most = static_cast<int>(std::min<double>(kMaxMergedSteps, std::floor(t_max / step)));
+  if (most < 2) return 0.0;
+  int k = 0;
+  while (k < most) {
+    // A quiet piece ahead (tried after the first step, then every fourth): the longest of
+    // 1, 2, 4, … steps from here.
+    if (k == 1 || (k > 0 && k % 4 == 0)) {
+      int quiet = 0;
+      for (int piece = 1; k + piece <= most && quiet_between(k * step, (k + piece) * step); piece *= 2) quiet = piece;
+      if (quiet > 0) {
+        k += quiet;
+        continue;
+      }
+    }
+    const double t = (k + 1) * step;
+    glm::dvec3 mid(0.0);
+    for (int c = 0; c < 4; ++c) {
+      const glm::dvec3 end = patch.x[c] + t * v[static_cast<std::size_t>(c)];
+      if (sampler.materialAt(end) != patch.medium[c]) return k >= 2 ? k * step : 0.0;
+      mid += 0.25 * end;
+    }
+    ++k;
+    if (!insideBox(mid, ctx.box_lo, ctx.box_hi)) break;
+  }
+  return k >= 2 ? k * step : 0.0;
+}
+
 // Free flight (ALGORITHM.md "Free flight"): the time of one straight step for the whole patch,
 // or 0 when it takes an ordinary step of Δt. Every corner moves on its straight ray
 // x_c + t·w_c/n_c², so the patch swept from t0 to t1 lies in the box of its corners at t0 and t1
@@ -294,7 +343,9 @@ double freeFlightTime(const Patch& patch, const PatchSamples& samples, const Ste
     good = tt;
     if (tt >= t_max) break;
   }
-  if (good == 0.0) return 0.0;
+  // A patch longer than the split length (it crossed an interface unsplit) splits at its next look.
+  const bool split_due = !kept && patch.longestEdge() > threshold;
+  if (good == 0.0) return mergedStepsTime(patch, v, ctx, t_max, split_due, quietBetween);
   if (bad > 0.0)
     for (int i = 0; i < 3; ++i) {
       const double mid = 0.5 * (good + bad);
@@ -404,9 +455,9 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
   const glm::dvec3 m_new = patch.midpoint();
   const glm::dvec3 d_new = patch.direction();
   if (sharp) {
-    // After a flight the midpoint is in the corners' material (the swept box was quiet: one
-    // material, constant optics), so its n is theirs, with no lookup.
-    samples.n_mid = flight > 0.0 ? samples.corner[0].x : sampler.materialOptics(sampler.materialAt(m_new), m_new).x;
+    // (After a flight toward a surface the midpoint may lie across a feature thinner than the
+    // patch, so it is looked up after every step.)
+    samples.n_mid = sampler.materialOptics(sampler.materialAt(m_new), m_new).x;
     patch.t_fresnel = crossing.transmittance;
     if (crossing.transmittance < 1.0) {
       result.reflected = patch.flux * (1.0 - crossing.transmittance);

@@ -23,6 +23,7 @@ StepUniforms StepUniforms::from(const GridSpec& grid, const SimulationOptions& o
   step.boxMax = glm::vec3(hi);
   step.flightCap = static_cast<float>(glm::length(hi - lo));
   step.bounces = options.bounces;
+  step.mergeSteps = options.merge_straight_steps;
   return step;
 }
 

@@ -26,6 +26,7 @@ struct StepUniforms {
   // Free flight with volume deposits: the track deposit pass's bound on a step's extent, in voxels
   // (TrackDepositUniforms::maxExtentVoxels); 0: none (no volume deposits).
   float flightExtentVoxels = 0.0f;
+  bool mergeSteps = true;                       // SimulationOptions::merge_straight_steps
   float boundaryOn = 0.0f, boundaryOff = 0.0f;  // g_on, g_off
   float fluxKill = 0.0f;                        // flux_threshold · Φ_ref
   float splitLength = 0.0f;                     // split_voxels · h · (1 + margin)

@@ -55,6 +55,9 @@ void UpdatePass::run(const PatchTextures& in, PatchTextures& out, const LiveCoun
   program_.set("uStraightReach", step.straightReach);
   program_.set("uFlightCap", step.flightCap);
   program_.set("uFlightExtentVoxels", step.flightExtentVoxels);
+  program_.set("uMergeSteps", step.mergeSteps);
+  program_.set("uBoxMin", step.boxMin);
+  program_.set("uBoxMax", step.boxMax);
   program_.set("uKeepAtMaxDepth", !step.killAtMaxDepth);
   program_.set("uBoundaryOn", step.boundaryOn);
   program_.set("uBoundaryOff", step.boundaryOff);

@@ -1,6 +1,6 @@
 // Free flight and straight steps in the update pass (ALGORITHM.md "Free flight", "Straight
-// steps"): the GPU twin of QuietMap::quiet (lightsim/quiet_map.h), freeFlightTime and
-// sharpStepTime (cpu_simulator.cpp), line by line in float. Needs lightsim/grid.glsl and
+// steps"): the GPU twin of QuietMap::quiet (lightsim/quiet_map.h), freeFlightTime,
+// mergedStepsTime and sharpStepTime (cpu_simulator.cpp), line by line in float. Needs lightsim/grid.glsl and
 // lightsim/patch.glsl (with SHARP_INTERFACES, lightsim/sharp.glsl).
 //   FREE_FLIGHT   the quiet map's summed-area table is bound to uQuietSat
 //   ABSORBER_MAP  the absorber map's (σa ≠ 0 voxels) to uAbsorberSat: straight steps only where
@@ -19,6 +19,11 @@ uniform bool uKeepAtMaxDepth; // DepthLimit::Keep
 // With volume deposits: the track deposit pass's bound on a patch-step's extent, in voxels of each
 // axis (TrackDepositUniforms::maxExtentVoxels); 0: no bound (the receiver map only).
 uniform float uFlightExtentVoxels;
+#ifdef SHARP_INTERFACES
+uniform bool uMergeSteps;     // SimulationOptions::merge_straight_steps
+uniform vec3 uBoxMin;         // the propagation box (wavefront.h propagationBox)
+uniform vec3 uBoxMax;
+#endif
 #endif
 #ifdef ABSORBER_MAP
 uniform usampler3D uAbsorberSat;
@@ -77,6 +82,50 @@ bool flightFits(Patch p, vec3 v[4], float t) {
   return all(lessThanEqual(vhi - vlo, vec3(uFlightExtentVoxels)));
 }
 
+#ifdef SHARP_INTERFACES
+// mergedStepsTime (cpu_simulator.cpp): where the quiet map lets no flight start and straight steps
+// apply, the next straight steps whose ends keep every corner in its own material, taken as one
+// (k ≥ 2 of them, at most 64; the ends asked one by one except along quiet pieces, none past the
+// step whose midpoint leaves the box); 0: an ordinary step. With volume deposits, no more of them
+// than the track deposit pass reaches (flightFits).
+float mergedStepsTime(Patch p, vec3 v[4], float tMax, bool splitDue) {
+#ifdef ABSORBER_MAP
+  return 0.0;  // σa a field: straight steps only where nothing absorbs near (sharpStepTime)
+#else
+  if (!uMergeSteps || !(uStepDt > uDt) || p.reflected != 0 || splitDue) return 0.0;
+  float stepTime = p.bounce > 0 ? uReflectedStepDt : uStepDt;
+  int most = int(min(64.0, floor(tMax / stepTime)));
+  if (most < 2) return 0.0;
+  int k = 0;
+  bool met = false;
+  while (k < most && !met) {
+    if (k == 1 || (k > 0 && k % 4 == 0)) {
+      int quiet = 0;
+      for (int piece = 1; k + piece <= most && flightQuiet(p, v, float(k) * stepTime, float(k + piece) * stepTime);
+           piece *= 2)
+        quiet = piece;
+      if (quiet > 0) {
+        k += quiet;
+        continue;
+      }
+    }
+    float t = float(k + 1) * stepTime;
+    vec3 mid = vec3(0.0);
+    for (int c = 0; c < 4; ++c) {
+      vec3 end = p.x[c] + t * v[c];
+      if (materialAt(end) != p.medium[c]) met = true;
+      mid += 0.25 * end;
+    }
+    if (met) break;
+    ++k;
+    if (!insideBox(mid, uBoxMin, uBoxMax)) break;
+  }
+  while (k >= 2 && !flightFits(p, v, float(k) * stepTime)) --k;
+  return k >= 2 ? float(k) * stepTime : 0.0;
+#endif
+}
+#endif
+
 // freeFlightTime (cpu_simulator.cpp): the time of one straight step for the whole patch, or 0 for
 // an ordinary step. Every corner moves on its straight ray, so the swept patch lies in the box of
 // its corners at 0 and t, checked piece by piece ([good, t] of the doubling and of the bisection);
@@ -129,7 +178,16 @@ float freeFlightTime(Patch p) {
     good = tt;
     if (tt >= tMax) break;
   }
+#ifdef SHARP_INTERFACES
+  if (good == 0.0) {
+    // A patch longer than the split length (it crossed an interface unsplit) splits at its next look.
+    float longest = 0.0;
+    for (int c = 0; c < 4; ++c) longest = max(longest, distance(p.x[(c + 1) % 4], p.x[c]));
+    return mergedStepsTime(p, v, tMax, !kept && longest > splitLength);
+  }
+#else
   if (good == 0.0) return 0.0;
+#endif
   if (bad > 0.0)
     for (int i = 0; i < 3; ++i) {
       float mid = 0.5 * (good + bad);
