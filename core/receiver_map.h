@@ -40,6 +40,19 @@ struct ReceiverMap {
   glm::dvec2 planeCoordinates(const glm::dvec3& world) const {
     return {glm::dot(world - point, u), glm::dot(world - point, v)};
   }
+  // The map without its irradiance (every other member copied).
+  ReceiverMap geometry() const {
+    ReceiverMap g;
+    g.name = name;
+    g.point = point;
+    g.normal = normal;
+    g.u = u;
+    g.v = v;
+    g.origin = origin;
+    g.pitch = pitch;
+    g.texels = texels;
+    return g;
+  }
   // The oriented NRRD header of the map (3 components).
   NrrdHeader nrrdHeader() const;
   // The manifest entry, with `file` the NRRD's name relative to the manifest.

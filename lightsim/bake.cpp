@@ -112,7 +112,7 @@ nlohmann::json SimulationStats::toJson() const {
   return j;
 }
 
-void applyBake(Volume& volume, const BakeResult& result, const LightSpec& light) {
+void applyBake(Volume& volume, BakeResult&& result, const LightSpec& light) {
   const std::size_t n = volume.grid.count();
   auto check = [n](const Field& f, const char* name) {
     if (f.components != 3 || f.data.size() != n * 3)
@@ -125,21 +125,31 @@ void applyBake(Volume& volume, const BakeResult& result, const LightSpec& light)
   } else {
     check(result.irradiance, "irradiance");
     check(result.light_dir, "light_dir");
-    volume.fields["irradiance"] = result.irradiance;
-    volume.fields["light_dir"] = result.light_dir;
+    volume.fields["irradiance"] = std::move(result.irradiance);
+    volume.fields["light_dir"] = std::move(result.light_dir);
   }
-  volume.receivers = result.receivers;
+  volume.receivers = std::move(result.receivers);
   volume.metadata["light"] = light.toJson();
   volume.metadata.erase("lights");
   volume.metadata["bake_stats"] = result.stats.toJson();
 }
 
-void applyBake(Volume& volume, const BakeResult& result, const std::vector<LightSpec>& lights) {
-  applyBake(volume, result, lights.at(0));
+void applyBake(Volume& volume, BakeResult&& result, const std::vector<LightSpec>& lights) {
+  applyBake(volume, std::move(result), lights.at(0));
   if (lights.size() < 2) return;
   nlohmann::json all = nlohmann::json::array();
   for (const LightSpec& light : lights) all.push_back(light.toJson());
   volume.metadata["lights"] = all;
+}
+
+void applyBake(Volume& volume, const BakeResult& result, const LightSpec& light) {
+  BakeResult copy = result;
+  applyBake(volume, std::move(copy), light);
+}
+
+void applyBake(Volume& volume, const BakeResult& result, const std::vector<LightSpec>& lights) {
+  BakeResult copy = result;
+  applyBake(volume, std::move(copy), lights);
 }
 
 bool viewerReadsVolumeLight(const Volume& volume, bool receiver_map) {

@@ -21,6 +21,10 @@ void applyBake(Volume& volume, const BakeResult& result, const LightSpec& light)
 // a receiver map's reader takes off exactly, and "lights" all of them in order (only when there are
 // two or more; a one-light bake removes an earlier bake's list).
 void applyBake(Volume& volume, const BakeResult& result, const std::vector<LightSpec>& lights);
+// The same, moving the result's fields and maps into the volume instead of copying them (at 128³
+// a receiver map of 1024² texels is 12 MB of fresh memory a copy would touch).
+void applyBake(Volume& volume, BakeResult&& result, const LightSpec& light);
+void applyBake(Volume& volume, BakeResult&& result, const std::vector<LightSpec>& lights);
 
 // Whether the viewer reads a bake's volume fields (irradiance, light_dir) for this volume: it does
 // for in-scattering (a `scatter` field with a non-zero albedo somewhere), for opaque embeddings (an

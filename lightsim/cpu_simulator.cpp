@@ -185,7 +185,7 @@ SharpUpdate updateCornersSharp(Patch& patch, PatchSamples& samples, const StepCo
     if (cc.reflected > 0) u.reflected_mask |= 1 << c;
     u.blocked += cc.blocked ? 1 : 0;
     if (cc.transmitted > 0) u.transmitted_mask |= 1 << c;
-    u.transmittance *= std::pow(cc.transmittance, 0.25);
+    if (cc.transmittance != 1.0) u.transmittance *= std::pow(cc.transmittance, 0.25);  // (1 without a crossing)
     u.optical_depth += 0.25 * cc.optical_depth;
   }
   return u;

@@ -125,8 +125,9 @@ int run(int argc, char** argv) {
   std::string free_flight = "on";
   app.add_option("--free-flight", free_flight,
                  "on (default: a patch crosses quiet space, where n is constant and no interface lies, in one "
-                 "straight step; the same bake in fewer steps; with volume deposits the GPU path flies only as "
-                 "far as its deposit pass reaches) or off (steps of --step everywhere)")
+                 "straight step, and near surfaces takes the straight steps in which no corner meets one together; "
+                 "the same bake in fewer steps; with volume deposits the GPU path flies only as far as its deposit "
+                 "pass reaches) or off (steps of --step or --straight-step everywhere)")
       ->check(CLI::IsMember({"on", "off"}));
   options.straight_step_voxels = 2.0;
   app.add_option("--straight-step", options.straight_step_voxels,
@@ -353,7 +354,8 @@ int run(int argc, char** argv) {
       BakeResult none;
       bakeToVolumeFrame(none, baked_lights[k], bake.scale);
     }
-    applyBake(volume, result, baked_lights);
+    const SimulationStats stats = result.stats;
+    applyBake(volume, std::move(result), baked_lights);
     volume.metadata["bake_options"] = bakeOptionsToJson(bake.options);
     if (bands.size() > 1) volume.metadata["bake_bands"] = bands.size();
     if (smooth_irradiance > 0.0) volume.metadata["irradiance_smoothing_sigma_voxels"] = smooth_irradiance;
@@ -367,11 +369,11 @@ int run(int argc, char** argv) {
     writeVolume(volume, output, write_options);
     if (!stats_path.empty()) writeFileAtomic(stats_path, stats_json.dump(2) + "\n");
     if (!quiet) {
-      const SimulationStats& s = result.stats;
+      const SimulationStats& s = stats;
       std::fprintf(stderr, "lightsim: %d steps, %llu initial / %llu peak patches, %llu splits on %s\n", s.steps,
                    static_cast<unsigned long long>(s.initial_patches), static_cast<unsigned long long>(s.peak_patches),
                    static_cast<unsigned long long>(s.splits), rendererName(s).c_str());
-      for (const ReceiverMap& map : result.receivers)
+      for (const ReceiverMap& map : volume.receivers)
         std::fprintf(stderr, "lightsim: receiver '%s': %d x %d texels of %.4g, %.4g W of %.4g W received\n",
                      map.name.c_str(), map.texels.x, map.texels.y, map.pitch, luminance(s.flux_received),
                      luminance(s.flux_in));

@@ -177,8 +177,9 @@ struct SceneRenderer::Impl {
     o.receiver_light_spot = found.light_spot;
     o.receiver_light_spot_scale = found.light_spot_scale;
     o.receiver_other_lights = found.other_lights;
-    o.receiver = *found.map;  // with its irradiance, for the ground map
-    if (!for_ground_map) o.receiver.irradiance = {};
+    // With its irradiance for the ground map only (a lone object's is uploaded as its texels; the
+    // copy would be 12 MB of fresh memory at 1024² texels).
+    o.receiver = for_ground_map ? *found.map : found.map->geometry();
     o.receiver_texture = gl::Texture2D(found.map->texels, gl::TextureFormat::RGBA32F,
                                        prepared ? *prepared : groundTexels(loaded, found), 4);
     o.has_receiver = true;
