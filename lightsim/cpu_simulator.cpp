@@ -252,14 +252,16 @@ double mergedStepsTime(const Patch& patch, const std::array<glm::dvec3, 4>& v, c
   const int most = static_cast<int>(std::min<double>(kMaxMergedSteps, std::floor(t_max / step)));
   if (most < 2) return 0.0;
   int k = 0;
+  int next_try = 1;  // when to look for a quiet piece next: after 1, 3, 7, 15, … steps in noisy space
   while (k < most) {
-    // A quiet piece ahead (tried after the first step, then every fourth): the longest of
-    // 1, 2, 4, … steps from here.
-    if (k == 1 || (k > 0 && k % 4 == 0)) {
+    // A quiet piece ahead: the longest of 1, 2, 4, … steps from here.
+    if (k == next_try) {
       int quiet = 0;
       for (int piece = 1; k + piece <= most && quiet_between(k * step, (k + piece) * step); piece *= 2) quiet = piece;
+      next_try = 2 * k + 1;
       if (quiet > 0) {
         k += quiet;
+        next_try = k;
         continue;
       }
     }
