@@ -25,13 +25,21 @@ struct UnionDistance {
     const glm::dvec3 f = g - f0;
     const glm::ivec3 i0 = glm::clamp(glm::ivec3(f0), glm::ivec3(0), hi);
     const glm::ivec3 i1 = glm::clamp(glm::ivec3(f0) + 1, glm::ivec3(0), hi);
+    // The eight taps' offsets in floats from the first (the field's layout: x fastest, then y, z).
+    const std::size_t components = static_cast<std::size_t>(field.components);
+    const std::size_t sx = static_cast<std::size_t>(grid.dims.x), sxy = sx * static_cast<std::size_t>(grid.dims.y);
+    const std::size_t dx = static_cast<std::size_t>(i1.x - i0.x) * components;
+    const std::size_t dy = static_cast<std::size_t>(i1.y - i0.y) * sx * components;
+    const std::size_t dz = static_cast<std::size_t>(i1.z - i0.z) * sxy * components;
+    const float* base = field.voxel(grid.index(i0.x, i0.y, i0.z));
     double best = 1e30;
     for (int k = 0; k < slots; ++k) {
-      auto d = [&](int x, int y, int z) { return static_cast<double>(field.voxel(grid.index(x, y, z))[k]); };
-      const double c00 = d(i0.x, i0.y, i0.z) * (1 - f.x) + d(i1.x, i0.y, i0.z) * f.x;
-      const double c10 = d(i0.x, i1.y, i0.z) * (1 - f.x) + d(i1.x, i1.y, i0.z) * f.x;
-      const double c01 = d(i0.x, i0.y, i1.z) * (1 - f.x) + d(i1.x, i0.y, i1.z) * f.x;
-      const double c11 = d(i0.x, i1.y, i1.z) * (1 - f.x) + d(i1.x, i1.y, i1.z) * f.x;
+      const float* p = base + k;
+      auto d = [&](std::size_t offset) { return static_cast<double>(p[offset]); };
+      const double c00 = d(0) * (1 - f.x) + d(dx) * f.x;
+      const double c10 = d(dy) * (1 - f.x) + d(dx + dy) * f.x;
+      const double c01 = d(dz) * (1 - f.x) + d(dx + dz) * f.x;
+      const double c11 = d(dy + dz) * (1 - f.x) + d(dx + dy + dz) * f.x;
       const double v = (c00 * (1 - f.y) + c10 * f.y) * (1 - f.z) + (c01 * (1 - f.y) + c11 * f.y) * f.z;
       best = std::min(best, v);
     }
