@@ -149,7 +149,7 @@ struct SceneRenderer::Impl {
   // The receiver texture's texels: the map with its shadow's edge to the pixel (shadow_edge.h:
   // directional light without an angular size, sharp interfaces; a light's disc makes the edge a
   // penumbra, which the map holds as baked). No GL: SceneRenderer::prepare runs it before a context.
-  static std::vector<float> groundTexels(const LoadedObject& loaded, const GroundReceiver& found) {
+  static std::vector<std::uint16_t> groundTexels(const LoadedObject& loaded, const GroundReceiver& found) {
     const glm::dmat4 to_volume = glm::inverse(loaded.object_to_world);
     ReceiverLayer layer{found.map,
                         to_volume,
@@ -163,13 +163,13 @@ struct SceneRenderer::Impl {
     const std::vector<float> clearance =
         found.light_pos.w == 0.0f && !found.light_disc ? shadowClearance(loaded.volume, *found.map, glm::dvec3(found.light_pos))
                                   : std::vector<float>();
-    return receiverTexels(layer, clearance);
+    return receiverTexelsHalf(layer, clearance);
   }
 
   // `for_ground_map`: keep the map's irradiance, which only a ground map of two or more objects' maps
   // reads (buildGroundMap); a lone object's is uploaded as its texels and not kept twice.
   static void attachReceiver(Object& o, const LoadedObject& loaded, const SceneGroundSpec& ground,
-                             const std::vector<float>* prepared, bool for_ground_map) {
+                             const std::vector<std::uint16_t>* prepared, bool for_ground_map) {
     const GroundReceiver found = findGroundReceiver(loaded, ground);
     if (!found.map) return;
     o.receiver_light_pos = found.light_pos;
@@ -180,13 +180,16 @@ struct SceneRenderer::Impl {
     // With its irradiance for the ground map only (a lone object's is uploaded as its texels; the
     // copy would be 12 MB of fresh memory at 1024² texels).
     o.receiver = for_ground_map ? *found.map : found.map->geometry();
-    o.receiver_texture = gl::Texture2D(found.map->texels, gl::TextureFormat::RGBA32F,
-                                       prepared ? *prepared : groundTexels(loaded, found), 4);
+    // RGBA16F: sampled once a ground hit, half the memory of RGBA32F (receiverTexelsHalf).
+    o.receiver_texture = gl::Texture2D(found.map->texels, gl::TextureFormat::RGBA16F);
+    const std::vector<std::uint16_t> texels = prepared ? std::vector<std::uint16_t>() : groundTexels(loaded, found);
+    const std::vector<std::uint16_t>& half = prepared ? *prepared : texels;
+    o.receiver_texture.uploadRaw(half.data(), half.size() * sizeof(std::uint16_t), GL_RGBA, GL_HALF_FLOAT);
     o.has_receiver = true;
   }
 
   // One object's textures, bounds and shader defines, from its volume (the constructor, replaceVolume).
-  Object makeObject(const LoadedObject& loaded, const std::vector<float>* prepared_texels = nullptr) const {
+  Object makeObject(const LoadedObject& loaded, const std::vector<std::uint16_t>* prepared_texels = nullptr) const {
     loaded.volume.require("ior", 1, loaded.source);
     const InterfaceTable table = interfaceTable(loaded.volume, loaded.source);
     iorGradient(loaded.volume, table, loaded.source);
@@ -454,7 +457,7 @@ SceneRenderer::SceneRenderer(const gl::ShaderLibrary& shaders, const LoadedScene
   glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &max_units);
   int units = s.environment.kind() == EnvironmentKind::Map ? 1 : 0;
   for (std::size_t i = 0; i < scene.objects.size(); ++i) {
-    const std::vector<float>* texels = nullptr;
+    const std::vector<std::uint16_t>* texels = nullptr;
     if (prepared && i < prepared->ground_texels.size() && prepared->ground_texels[i]) texels = &*prepared->ground_texels[i];
     Impl::Object o = s.makeObject(scene.objects[i], texels);
     units += o.textures.layout().textureCount() + 1;

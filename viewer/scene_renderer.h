@@ -12,6 +12,7 @@
 // each volume; viewer/IMAGE_FORMATION.md maps each equation to its code.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -38,7 +39,7 @@ class SceneRenderer {
   // on two cores), made beforehand — the headless viewer makes them while its driver loads
   // (gl::DriverPreload). A constructor given them builds the renderer it would build without.
   struct Preparation {
-    std::vector<std::optional<std::vector<float>>> ground_texels;  // per object; none: no map
+    std::vector<std::optional<std::vector<std::uint16_t>>> ground_texels;  // per object, RGBA16F; none: no map
   };
   static Preparation prepare(const LoadedScene& scene);
 

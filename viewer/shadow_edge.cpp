@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 
+#include "core/half_float.h"
 #include "core/interfaces.h"
 #include "core/parallel.h"
 
@@ -200,7 +202,11 @@ std::vector<float> shadowClearance(const Volume& volume, const ReceiverMap& map,
   return clearance;
 }
 
-std::vector<float> receiverTexels(const ReceiverLayer& layer, const std::vector<float>& clearance) {
+namespace {
+
+// receiverTexels, each texel's RGBA stored as `Out` (float, or half bits through toHalf).
+template <typename Out>
+std::vector<Out> texelsOf(const ReceiverLayer& layer, const std::vector<float>& clearance) {
   const ReceiverMap& map = *layer.map;
   const std::size_t n = map.texelCount();
   const bool edges = clearance.size() == n;
@@ -235,14 +241,14 @@ std::vector<float> receiverTexels(const ReceiverLayer& layer, const std::vector<
     return lit / 64.0;
   };
   const glm::dvec3 normal = glm::cross(map.u, map.v);
-  std::vector<float> rgba(4 * n);
+  std::vector<Out> rgba(4 * n);
   parallelFor(
       0, ny,
       [&](std::int64_t row) {
         const int j = static_cast<int>(row);
         for (int i = 0; i < nx; ++i) {
           const std::size_t t = static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i);
-          float* out = &rgba[4 * t];
+          float out[4];
           for (int k = 0; k < 3; ++k) out[k] = map.irradiance[3 * t + static_cast<std::size_t>(k)];
           out[3] = edges ? clearance[t] : 1.0f;
           if (!layer.other_lights.empty()) {
@@ -250,13 +256,28 @@ std::vector<float> receiverTexels(const ReceiverLayer& layer, const std::vector<
             for (int k = 0; k < 3; ++k) out[k] -= static_cast<float>(others[k]);
           }
           const double shaded = edges ? 1.0 - litFraction(i, j) : 0.0;
-          if (shaded <= 0.0) continue;
-          const glm::dvec3 D = bakedDirectIrradiance(layer, map.texelCenter(i, j), normal);
-          for (int k = 0; k < 3; ++k) out[k] += static_cast<float>(D[k] * shaded);
+          if (shaded > 0.0) {
+            const glm::dvec3 D = bakedDirectIrradiance(layer, map.texelCenter(i, j), normal);
+            for (int k = 0; k < 3; ++k) out[k] += static_cast<float>(D[k] * shaded);
+          }
+          for (int k = 0; k < 4; ++k) {
+            if constexpr (std::is_same_v<Out, float>) rgba[4 * t + static_cast<std::size_t>(k)] = out[k];
+            else rgba[4 * t + static_cast<std::size_t>(k)] = toHalf(out[k]);
+          }
         }
       },
       16);
   return rgba;
+}
+
+}  // namespace
+
+std::vector<float> receiverTexels(const ReceiverLayer& layer, const std::vector<float>& clearance) {
+  return texelsOf<float>(layer, clearance);
+}
+
+std::vector<std::uint16_t> receiverTexelsHalf(const ReceiverLayer& layer, const std::vector<float>& clearance) {
+  return texelsOf<std::uint16_t>(layer, clearance);
 }
 
 }  // namespace eik

@@ -25,6 +25,7 @@
 // texture is the map as it was (a point light's shadow keeps its texel-wide edge).
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -45,5 +46,9 @@ std::vector<float> shadowClearance(const Volume& volume, const ReceiverMap& map,
 // texel, given its clearance (empty: none, a = 1 and rgb the map), less the direct light of the
 // layer's other lights at each texel centre (so that the shader takes off only the first light's).
 std::vector<float> receiverTexels(const ReceiverLayer& layer, const std::vector<float>& clearance);
+// The same as half floats (core/half_float.h), what the viewer uploads (RGBA16F): half the memory
+// of a texture sampled once a ground hit, within 2⁻¹¹ of each value (the shadow's edge, where the
+// bilinear c crosses 0, moves by far less than a texel: c's relative precision is the same near 0).
+std::vector<std::uint16_t> receiverTexelsHalf(const ReceiverLayer& layer, const std::vector<float>& clearance);
 
 }  // namespace eik
