@@ -161,7 +161,20 @@ void writeGzipStream(std::span<const unsigned char> bytes, const GzipSink& write
 
   uLong crc = crc32(0, Z_NULL, 0);
   const std::size_t batch = 2 * static_cast<std::size_t>(workerThreads());
-  std::vector<std::string> compressed(batch);
+  // Each block's output, in a buffer left uninitialised: only the pages deflate writes are touched
+  // (a std::string sized to deflateBound would zero the whole bound, about the block's own size,
+  // when a float field compresses to a tenth of it).
+  struct Output {
+    std::unique_ptr<unsigned char[]> bytes;
+    std::size_t capacity = 0, size = 0;
+    void grow(std::size_t to) {
+      std::unique_ptr<unsigned char[]> larger(new unsigned char[to]);
+      if (size > 0) std::memcpy(larger.get(), bytes.get(), size);
+      bytes = std::move(larger);
+      capacity = to;
+    }
+  };
+  std::vector<Output> compressed(batch);
   std::vector<uLong> crcs(batch);
   for (std::size_t first = 0; first < blocks; first += batch) {
     const std::size_t count = std::min(batch, blocks - first);
@@ -178,27 +191,27 @@ void writeGzipStream(std::span<const unsigned char> bytes, const GzipSink& write
       stream.ready = true;
       z_stream& z = stream.z;
       if (block > 0) deflateSetDictionary(&z, bytes.data() + begin - kWindow, static_cast<uInt>(kWindow));
-      std::string& output = compressed[static_cast<std::size_t>(k)];
-      output.resize(deflateBound(&z, static_cast<uLong>(length)) + 64);
+      Output& output = compressed[static_cast<std::size_t>(k)];
+      output.size = 0;
+      const std::size_t bound = deflateBound(&z, static_cast<uLong>(length)) + 64;
+      if (output.capacity < bound) output.grow(bound);
       z.next_in = const_cast<unsigned char*>(bytes.data() + begin);
       z.avail_in = static_cast<uInt>(length);
-      std::size_t produced = 0;
       while (true) {
-        z.next_out = reinterpret_cast<unsigned char*>(output.data() + produced);
-        z.avail_out = static_cast<uInt>(output.size() - produced);
+        z.next_out = output.bytes.get() + output.size;
+        z.avail_out = static_cast<uInt>(output.capacity - output.size);
         int status = deflate(&z, last ? Z_FINISH : Z_SYNC_FLUSH);
-        produced = output.size() - z.avail_out;
+        output.size = output.capacity - z.avail_out;
         if (status == Z_STREAM_ERROR) throw RuntimeError(name + ": gzip compression failed");
         if (last ? status == Z_STREAM_END : (z.avail_in == 0 && z.avail_out != 0)) break;
-        output.resize(output.size() * 2);  // not reached with deflateBound's size; kept for safety
+        output.grow(output.capacity * 2);  // not reached with deflateBound's size; kept for safety
       }
-      output.resize(produced);
       // libdeflate's CRC-32 (the same checksum, carry-less multiplication: several times zlib's speed).
       crcs[static_cast<std::size_t>(k)] = libdeflate_crc32(0, bytes.data() + begin, length);
     });
     for (std::size_t k = 0; k < count; ++k) {
       const std::size_t length = std::min(kBlock, bytes.size() - (first + k) * kBlock);
-      write(compressed[k].data(), compressed[k].size());
+      write(compressed[k].bytes.get(), compressed[k].size);
       crc = crc32_combine(crc, crcs[k], static_cast<z_off_t>(length));
     }
   }
