@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstdio>
 #include <cstring>
 #include <numbers>
 #include <optional>
@@ -545,15 +546,18 @@ TEST(CpuSimulator, SameBitsWhateverTheThreadCount) {
   LightSpec light;
   light.direction = glm::normalize(glm::dvec3(0.3, -1.0, 0.2));
   light.power = {1.0, 0.7, 0.4};
-  // Free flight on a sharp sphere (the smoothed one has ∇n ≠ 0 in every voxel: nowhere quiet).
+  // Free flight on a sharp sphere (the smoothed one has ∇n ≠ 0 in every voxel: nowhere quiet),
+  // then also with straight steps, merged near the surface (mergedStepsTime).
   const Volume sharp = sharpVolume("procedural:sphere,r=0.5,ior=1.5", 20, cube(0.6));
-  for (const bool flight : {false, true}) {
+  for (const int mode : {0, 1, 2}) {
+  const bool flight = mode > 0;
   auto bake = [&](int threads) {
     ScopedThreads scope(threads);
     CpuSimulator sim(flight ? sharp : v);
     SimulationOptions o;
     o.max_depth = 5;  // fewer patches, same machinery
     o.free_flight = flight;
+    if (mode == 2) o.straight_step_voxels = 2.0;
     if (flight) {
       // A floor with its map beyond the sphere's shadow: footprints by bands of rows, and the
       // direct light in closed form (directMapLight), also by bands.
@@ -586,6 +590,40 @@ TEST(CpuSimulator, SameBitsWhateverTheThreadCount) {
   EXPECT_EQ(one.receivers.size(), flight ? 1u : 0u);
   EXPECT_GT(one.stats.splits, 0u);
   }
+}
+
+// The merged straight steps change nothing but where a patch is looked at: with volume deposits
+// too (retaken straight steps, track deposits along the merged chords), a merged bake's volume
+// light is the single steps' to rounding and the light's ledger closes.
+TEST(CpuSimulator, MergedStraightStepsKeepTheVolumeLight) {
+  const Volume sharp = sharpVolume("procedural:sphere,r=0.5,ior=1.5", 24, cube(0.6));
+  CpuSimulator sim(sharp);
+  LightSpec light;
+  light.direction = glm::normalize(glm::dvec3(0.3, -1.0, 0.2));
+  SimulationOptions merged;
+  merged.max_depth = 5;
+  merged.free_flight = true;
+  merged.straight_step_voxels = 2.0;
+  SimulationOptions single = merged;
+  single.merge_straight_steps = false;
+  const BakeResult a = sim.run(light, merged), b = sim.run(light, single);
+  EXPECT_LT(a.stats.total_patches, b.stats.total_patches);
+  EXPECT_LT(ledgerResidual(a.stats), 1e-9);
+  double diff = 0.0, norm = 0.0;
+  for (std::size_t i = 0; i < a.irradiance.data.size(); ++i) {
+    const double d = static_cast<double>(a.irradiance.data[i]) - b.irradiance.data[i];
+    diff += d * d;
+    norm += static_cast<double>(b.irradiance.data[i]) * b.irradiance.data[i];
+  }
+  // Relative L2 within 1 % (measured 2.9·10⁻³ at 24³, in 71.6 k against 125 k patch-steps: where
+  // a patch tears at the surface moves as with a slightly other straight step, see
+  // CpuSimulator.MergedStraightStepsBakeTheSameLightInFewerPatchSteps).
+  std::printf("merged against single straight steps: volume light %.3g relative L2, %llu against %llu patch-steps\n",
+              std::sqrt(diff / norm), static_cast<unsigned long long>(a.stats.total_patches),
+              static_cast<unsigned long long>(b.stats.total_patches));
+  EXPECT_LT(std::sqrt(diff / norm), 1e-2);
+  EXPECT_NEAR(luminance(a.stats.flux_absorbed + a.stats.flux_out + a.stats.flux_reflected),
+              luminance(b.stats.flux_absorbed + b.stats.flux_out + b.stats.flux_reflected), 2e-3 * luminance(b.stats.flux_in));
 }
 
 // In a volume whose sharp materials all have a constant n no sample reads the n and ∇n fields
