@@ -116,8 +116,8 @@ struct SimulationOptions {
   // Merged straight steps (ALGORITHM.md "Free flight"): where free flight and straight steps both
   // apply, a patch the quiet map will not let fly looks at its next straight steps' ends and takes
   // the ones in which no corner meets an interface as one step: the corners' paths are the same,
-  // in fewer patch-steps (half at the 128³ sphere over a floor). CPU twin only; off: one straight
-  // step at a time, as the GPU path steps.
+  // in fewer patch-steps (half at the 128³ sphere over a floor). Both back ends (the GPU path's
+  // flight.glsl mergedStepsTime); off: one straight step at a time.
   bool merge_straight_steps = true;
   // Volume deposits (ALGORITHM.md step 4): the bake's `irradiance` and `light_dir` fields. Off, a
   // bake makes only the receiver's map (and the statistics): the deposits, most of a glass
