@@ -68,24 +68,31 @@ bool clipToBox(const glm::dvec3& p, const glm::dvec3& d, const glm::dvec3& lo, c
 }
 
 // The box of the voxel centres whose least slot distance is under the band; false when none is.
+// Each row is scanned from its ends for its first and last such voxel (most rows have none).
 bool nearSurfaces(const GridSpec& grid, const Field& field, int slots, double band, glm::dvec3& lo, glm::dvec3& hi) {
   const glm::ivec3 dims = grid.dims;
   std::vector<glm::ivec3> slabLo(static_cast<std::size_t>(dims.z), glm::ivec3(INT32_MAX)),
       slabHi(static_cast<std::size_t>(dims.z), glm::ivec3(-1));
   const auto limit = static_cast<float>(band * (1.0 - 1e-6));
+  const std::size_t components = static_cast<std::size_t>(field.components);
   parallelFor(0, dims.z, [&](std::int64_t z) {
     glm::ivec3& l = slabLo[static_cast<std::size_t>(z)];
     glm::ivec3& u = slabHi[static_cast<std::size_t>(z)];
     for (int y = 0; y < dims.y; ++y) {
       const float* row = field.voxel(grid.index(0, y, static_cast<int>(z)));
-      for (int x = 0; x < dims.x; ++x) {
-        const float* d = row + static_cast<std::size_t>(x) * static_cast<std::size_t>(field.components);
-        bool near = false;
-        for (int k = 0; k < slots; ++k) near = near || d[k] < limit;
-        if (!near) continue;
-        l = glm::min(l, glm::ivec3(x, y, static_cast<int>(z)));
-        u = glm::max(u, glm::ivec3(x, y, static_cast<int>(z)));
-      }
+      auto near = [&](int x) {
+        const float* d = row + static_cast<std::size_t>(x) * components;
+        bool any = false;
+        for (int k = 0; k < slots; ++k) any = any || d[k] < limit;
+        return any;
+      };
+      int first = 0;
+      while (first < dims.x && !near(first)) ++first;
+      if (first == dims.x) continue;
+      int last = dims.x - 1;
+      while (!near(last)) --last;
+      l = glm::min(l, glm::ivec3(first, y, static_cast<int>(z)));
+      u = glm::max(u, glm::ivec3(last, y, static_cast<int>(z)));
     }
   });
   glm::ivec3 l(INT32_MAX), u(-1);
@@ -99,6 +106,83 @@ bool nearSurfaces(const GridSpec& grid, const Field& field, int slots, double ba
   return true;
 }
 
+// Where the union's distance is the band throughout, in bricks of kBrick³ voxels: each brick's
+// Chebyshev distance, in bricks, from the nearest brick that is not (0: the brick itself is near a
+// surface, or may be; at most 255). A brick is far when every voxel its points' trilinear taps
+// read (its own and the next layer up each axis, clamped at the grid's faces) holds the band (or
+// more) in every slot: the trilinear distance anywhere in it is then the band. From a point in a
+// brick at distance k ≥ 2, the next (k − 1)·kBrick voxels in any direction stay in far bricks, so
+// the march may skip them: the least distance along them is the band it starts from.
+class FarBricks {
+ public:
+  static constexpr int kBrick = 4;
+
+  FarBricks(const GridSpec& grid, const Field& field, int slots, double band) : grid_(grid) {
+    dims_ = (grid.dims + kBrick - 1) / kBrick;
+    const std::size_t count = static_cast<std::size_t>(dims_.x) * static_cast<std::size_t>(dims_.y) * static_cast<std::size_t>(dims_.z);
+    steps_.assign(count, 0);
+    const auto limit = static_cast<float>(band * (1.0 - 1e-6));
+    const std::size_t components = static_cast<std::size_t>(field.components);
+    // Far bricks: 255 (not yet a distance), near ones 0.
+    parallelFor(0, dims_.z, [&](std::int64_t bz) {
+      for (int by = 0; by < dims_.y; ++by)
+        for (int bx = 0; bx < dims_.x; ++bx) {
+          const glm::ivec3 b(bx, by, static_cast<int>(bz));
+          const glm::ivec3 v0 = b * kBrick, v1 = glm::min(v0 + kBrick, grid.dims - 1);
+          bool far = true;
+          for (int z = v0.z; z <= v1.z && far; ++z)
+            for (int y = v0.y; y <= v1.y && far; ++y) {
+              const float* d = field.voxel(grid.index(v0.x, y, z));
+              const std::size_t n = static_cast<std::size_t>(v1.x - v0.x + 1) * components;
+              for (std::size_t i = 0; i < n; i += components)
+                for (int k = 0; k < slots; ++k) far = far && d[i + static_cast<std::size_t>(k)] >= limit;
+            }
+          steps_[index(b)] = far ? 255 : 0;
+        }
+    });
+    // The Chebyshev distance transform: two raster passes of the 3×3×3 neighbourhood (forward
+    // over the 13 neighbours before a brick, backward over the 13 after it) are exact for it.
+    auto pass = [&](int sign) {
+      const glm::ivec3 start = sign > 0 ? glm::ivec3(0) : dims_ - 1;
+      for (int z = start.z; z >= 0 && z < dims_.z; z += sign)
+        for (int y = start.y; y >= 0 && y < dims_.y; y += sign)
+          for (int x = start.x; x >= 0 && x < dims_.x; x += sign) {
+            std::uint8_t& s = steps_[index({x, y, z})];
+            if (s == 0) continue;
+            int best = s;
+            for (int dz = -1; dz <= 0; ++dz)
+              for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                  if (dz == 0 && (dy > 0 || (dy == 0 && dx >= 0))) continue;  // not before the brick
+                  const glm::ivec3 n(x + sign * dx, y + sign * dy, z + sign * dz);
+                  if (glm::any(glm::lessThan(n, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(n, dims_))) continue;
+                  best = std::min(best, steps_[index(n)] + 1);
+                }
+            s = static_cast<std::uint8_t>(std::min(best, 255));
+          }
+    };
+    pass(+1);
+    pass(-1);
+  }
+
+  // The distance of the brick holding the trilinear lookup's first tap at x (volume space).
+  int at(const glm::dvec3& x) const {
+    const glm::ivec3 v = glm::clamp(glm::ivec3(glm::floor(grid_.toVoxel(x) - 0.5)), glm::ivec3(0), grid_.dims - 1);
+    return steps_[index(v / kBrick)];
+  }
+
+ private:
+  std::size_t index(const glm::ivec3& b) const {
+    return (static_cast<std::size_t>(b.z) * static_cast<std::size_t>(dims_.y) + static_cast<std::size_t>(b.y)) *
+               static_cast<std::size_t>(dims_.x) +
+           static_cast<std::size_t>(b.x);
+  }
+
+  const GridSpec& grid_;
+  glm::ivec3 dims_;
+  std::vector<std::uint8_t> steps_;
+};
+
 }  // namespace
 
 std::vector<float> shadowClearance(const Volume& volume, const ReceiverMap& map, const glm::dvec3& direction) {
@@ -111,11 +195,14 @@ std::vector<float> shadowClearance(const Volume& volume, const ReceiverMap& map,
   const double h = std::min({voxel.x, voxel.y, voxel.z});
   const double band = table.band > 0.0 ? table.band : kInterfaceBandVoxels * h;
   // The march: steps of the distance itself where it is larger (nothing nearer can be skipped: a
-  // distance field changes by at most the step), half a voxel near and inside the surfaces
-  // (the least distance of a grazing ray is then found within h²/(32 R), R the surface's radius of
-  // curvature), and it stops three voxels inside (only the sign and the edge's neighbourhood
-  // matter).
-  const double fine = 0.5 * h, deep = -3.0 * h;
+  // distance field changes by at most the step), a voxel near and inside the surfaces, and it
+  // stops three voxels inside (only the sign and the edge's neighbourhood matter). Where the least
+  // distance was found, a parabola through that sample and its two neighbours puts the minimum
+  // between them and the distance there is looked up (a grazing ray's distance is a parabola in t
+  // near its minimum, s²/(2R) off for a surface of radius of curvature R: the fine steps alone find
+  // it within h²/(8R), the parabola's vertex far closer, as fine as steps of a tenth of a voxel).
+  // Through bricks far from every surface (FarBricks) it skips ahead.
+  const double fine = h, deep = -3.0 * h;
   const glm::dvec3 toLight = -glm::normalize(direction);
   // Only the box of the voxels nearer than the band to a surface (grown by a voxel) is marched:
   // elsewhere the distance is the band.
@@ -123,16 +210,56 @@ std::vector<float> shadowClearance(const Volume& volume, const ReceiverMap& map,
   if (!nearSurfaces(grid, *field, sdf.slots, band, lo, hi)) return std::vector<float>(map.texelCount(), static_cast<float>(band));
   lo -= glm::dvec3(h);
   hi += glm::dvec3(h);
+  const FarBricks far(grid, *field, sdf.slots, band);
+  const double skip_unit = FarBricks::kBrick * h;
   auto march = [&](int i, int j) {
     const glm::dvec3 p = map.texelCenter(i, j);
     double t0 = 0.0, t1 = 0.0;
     if (!clipToBox(p, toLight, lo, hi, t0, t1)) return band;
-    double best = band;
+    double best = band, t_best = 0.0;
+    double t_prev = 0.0, d_prev = band;            // the sample before the current one
+    double t_left = 0.0, d_left = band;            // the one before the best…
+    double t_right = 0.0, d_right = band;          // …and the one after it (t_right < t_best: none yet)
+    bool after_best = false, sampled = false;
     for (double t = t0; t <= t1;) {
-      const double d = sdf.at(p + t * toLight);
-      best = std::min(best, d);
-      if (best < deep) break;
+      const glm::dvec3 x = p + t * toLight;
+      const int k = far.at(x);
+      if (k >= 2) {
+        t += (k - 1) * skip_unit;
+        continue;
+      }
+      const double d = sdf.at(x);
+      if (after_best) {
+        t_right = t;
+        d_right = d;
+        after_best = false;
+      }
+      if (d < best) {
+        best = d;
+        t_best = t;
+        t_left = sampled ? t_prev : t;
+        d_left = sampled ? d_prev : d;
+        t_right = t;  // none after it yet
+        after_best = true;
+      }
+      if (best < deep) return best;
+      t_prev = t;
+      d_prev = d;
+      sampled = true;
       t += std::max(d, fine);
+    }
+    // The parabola through (t_left, d_left), (t_best, best), (t_right, d_right), when the best has
+    // a sample on each side and is below both.
+    if (best < band && t_left < t_best && t_right > t_best && best <= d_left && best <= d_right) {
+      const double a = t_best - t_left, b = t_right - t_best;
+      const double ga = (d_left - best) / a, gb = (d_right - best) / b;  // slopes down to, up from the best
+      // d ≈ best + β·s + γ·s², s = t − t_best: ga = γ·a − β, gb = γ·b + β.
+      const double gamma = (ga + gb) / (a + b);
+      const double beta = 0.5 * (gb - ga - gamma * (b - a));
+      if (gamma > 0.0) {
+        const double tv = t_best - beta / (2.0 * gamma);
+        if (tv > t_left && tv < t_right) best = std::min(best, sdf.at(p + tv * toLight));
+      }
     }
     return best;
   };

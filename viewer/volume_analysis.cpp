@@ -221,13 +221,20 @@ std::vector<float> homogeneousBricks(const Volume& volume, glm::ivec3& brick_dim
 bool materialTouchesBox(const Volume& volume) {
   const GridSpec& grid = volume.grid;
   const Field* ior = volume.find("ior");
-  for (int k = 0; k < grid.dims.z; ++k)
-    for (int j = 0; j < grid.dims.y; ++j)
-      for (int i = 0; i < grid.dims.x; ++i) {
-        const bool face = i == 0 || j == 0 || k == 0 || i == grid.dims.x - 1 || j == grid.dims.y - 1 ||
-                          k == grid.dims.z - 1;
-        if (face && std::abs(ior->data[grid.index(i, j, k)] - 1.0f) > 1e-3f) return true;
-      }
+  const glm::ivec3 last = grid.dims - 1;
+  auto material = [&](int i, int j, int k) { return std::abs(ior->data[grid.index(i, j, k)] - 1.0f) > 1e-3f; };
+  // The two faces across z, then across y, then across x (only the voxels on the box's faces).
+  for (int k : {0, last.z})
+    for (int j = 0; j <= last.y; ++j)
+      for (int i = 0; i <= last.x; ++i)
+        if (material(i, j, k)) return true;
+  for (int k = 0; k <= last.z; ++k) {
+    for (int j : {0, last.y})
+      for (int i = 0; i <= last.x; ++i)
+        if (material(i, j, k)) return true;
+    for (int j = 0; j <= last.y; ++j)
+      if (material(0, j, k) || material(last.x, j, k)) return true;
+  }
   return false;
 }
 

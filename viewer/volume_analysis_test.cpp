@@ -221,9 +221,13 @@ TEST(MaterialTouchesBox, OnlyWhereNDiffersFromOneOnAFace) {
   EXPECT_FALSE(materialTouchesBox(v));
   ior(v, 3, 5, 2) = 1.5f;  // on the top face
   EXPECT_TRUE(materialTouchesBox(v));
-  Volume w = air({6, 6, 6});
-  ior(w, 0, 2, 2) = 1.2f;  // on the x = 0 face
-  EXPECT_TRUE(materialTouchesBox(w));
+  // Glass at one voxel of each of the six faces (a box of 5 × 6 × 7 voxels), the rest air.
+  const glm::ivec3 on_face[6] = {{0, 2, 3}, {4, 3, 2}, {2, 0, 4}, {1, 5, 3}, {3, 2, 0}, {2, 4, 6}};
+  for (const glm::ivec3& f : on_face) {
+    Volume w = air({5, 6, 7});
+    ior(w, f.x, f.y, f.z) = 1.2f;
+    EXPECT_TRUE(materialTouchesBox(w)) << f.x << ", " << f.y << ", " << f.z;
+  }
 }
 
 TEST(AbsorbingRegion, IsTheBoxOfPositiveSigmaWithOneVoxelOfMargin) {
