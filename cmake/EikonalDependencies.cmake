@@ -7,7 +7,7 @@ find_package(nlohmann_json 3.10 REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(TinyGLTF REQUIRED)   # a compiled library on Debian: never define TINYGLTF_IMPLEMENTATION
 find_package(glfw3 3.3 REQUIRED)
-find_package(hwy 1.0 REQUIRED)     # Google Highway: the CPU twin's SIMD, dispatched at run time (lightsim/track_deposit_cpu.cpp)
+find_package(hwy 1.0 REQUIRED)     # Google Highway, header-only: the CPU twin's SIMD, dispatched at run time (lightsim/track_deposit_cpu.cpp)
 pkg_check_modules(OSMESA REQUIRED IMPORTED_TARGET osmesa)
 pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)
 # Dear ImGui 1.86 (libimgui-dev): libimgui.a holds the core and the back ends, imgui_impl_glfw and

@@ -18,6 +18,12 @@
 #include <cstdlib>
 #include <limits>
 #include <mutex>
+#include <string>
+#include <vector>
+
+#if HWY_ARCH_X86 && (defined(__GNUC__) || defined(__clang__))
+#include <cpuid.h>
+#endif
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -219,34 +225,82 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace eik {
 
-HWY_EXPORT(depositSlab);
-
 namespace {
 
-// The target the deposits run on (a HWY_* bit; 0: not chosen yet). Highway's dispatch picks the best
-// one the CPU runs; EIKONAL_SIMD or setTrackDepositTarget pick another (its ChosenTarget updated).
-std::atomic<std::int64_t> current_target{0};
+// The dispatch among the compiled targets is ours, not Highway's HWY_EXPORT / HWY_DYNAMIC_DISPATCH:
+// those call into libhwy.so (its target choice and CPU detection), and merely loading that library
+// costs every process 4–5 ms (a static initialiser of Debian's Highway 1.0.3 measures its timer's
+// resolution at start-up; BENCHMARKS.md), paid by `lightsim` and the viewer even where no deposit
+// runs. Highway is used header-only: its per-target code (foreach_target.h) and its names.
+using DepositSlabFn = decltype(&HWY_STATIC_DISPATCH(depositSlab));
 
-std::int64_t bestTarget() {
-  const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();  // best first
-  return targets.empty() ? HWY_STATIC_TARGET : targets.front();
+struct CompiledTarget {
+  std::int64_t target;  // a HWY_* bit
+  DepositSlabFn deposit;
+};
+
+// Whether this CPU (and its operating system, which must save the wide registers) runs a target's
+// code: the instruction sets Highway compiles each x86 target for (hwy/targets.h; its detection,
+// with the compiler's CPU tests and CPUID for the two they lack in Clang).
+bool cpuRuns(std::int64_t target) {
+#if HWY_ARCH_X86 && (defined(__GNUC__) || defined(__clang__))
+  __builtin_cpu_init();
+  const bool sse4 = __builtin_cpu_supports("ssse3") && __builtin_cpu_supports("sse4.1") &&
+                    __builtin_cpu_supports("sse4.2") && __builtin_cpu_supports("pclmul") && __builtin_cpu_supports("aes");
+  if (target == HWY_SSE4) return sse4;
+  unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
+  const bool f16c = __get_cpuid(1, &eax, &ebx, &ecx, &edx) && (ecx & (1u << 29)) != 0;         // CPUID.1:ECX.F16C
+  const bool lzcnt = __get_cpuid(0x80000001u, &eax, &ebx, &ecx, &edx) && (ecx & (1u << 5)) != 0;  // CPUID.80000001h:ECX.LZCNT
+  const bool avx2 = sse4 && __builtin_cpu_supports("avx") && __builtin_cpu_supports("avx2") &&
+                    __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2") &&
+                    f16c && lzcnt;
+  if (target == HWY_AVX2) return avx2;
+  if (target == HWY_AVX3)
+    return avx2 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+           __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw");
+#endif
+  return target == HWY_STATIC_TARGET || target == HWY_SCALAR || target == HWY_EMU128;
 }
 
-void chooseTarget(std::int64_t target) {
-  hwy::GetChosenTarget().Update(target == bestTarget() ? hwy::SupportedTargets() : target);
-  current_target.store(target);
+// The compiled targets this CPU runs, best first; the portable fallback last, always.
+const std::vector<CompiledTarget>& runnableTargets() {
+  static const std::vector<CompiledTarget> list = [] {
+    std::vector<CompiledTarget> all;
+#if HWY_ARCH_X86
+    all.push_back({HWY_AVX3, HWY_CHOOSE_AVX3(depositSlab)});
+    all.push_back({HWY_AVX2, HWY_CHOOSE_AVX2(depositSlab)});
+    all.push_back({HWY_SSE4, HWY_CHOOSE_SSE4(depositSlab)});
+#endif
+    if (HWY_STATIC_TARGET != HWY_SCALAR && HWY_STATIC_TARGET != HWY_EMU128)
+      all.push_back({HWY_STATIC_TARGET, &HWY_STATIC_DISPATCH(depositSlab)});
+    all.push_back({(HWY_TARGETS & HWY_EMU128) ? HWY_EMU128 : HWY_SCALAR, HWY_CHOOSE_FALLBACK(depositSlab)});
+    std::vector<CompiledTarget> runs;
+    for (const CompiledTarget& t : all) {
+      const bool listed = std::any_of(runs.begin(), runs.end(), [&](const CompiledTarget& r) { return r.target == t.target; });
+      if (t.deposit && !listed && cpuRuns(t.target)) runs.push_back(t);
+    }
+    return runs;
+  }();
+  return list;
 }
+
+// The target the deposits run on (its index in runnableTargets(); `chosen` once one is): the best
+// one the CPU runs, or the one EIKONAL_SIMD or setTrackDepositTarget picks.
+std::atomic<std::size_t> current_index{0};
+std::atomic<bool> chosen{false};
 
 // The first deposit's choice: EIKONAL_SIMD's target when it names one, else the best.
 void chooseOnce() {
   static std::once_flag once;
   std::call_once(once, [] {
-    if (current_target.load() != 0) return;  // setTrackDepositTarget came first
-    std::int64_t target = bestTarget();
+    if (chosen.load()) return;  // setTrackDepositTarget came first
+    std::size_t index = 0;
+    const std::vector<CompiledTarget>& targets = runnableTargets();
     if (const char* name = std::getenv("EIKONAL_SIMD"); name && *name)
-      for (const std::int64_t t : hwy::SupportedAndGeneratedTargets())
-        if (std::string(hwy::TargetName(t)) == name) target = t;
-    chooseTarget(target);
+      for (std::size_t i = 0; i < targets.size(); ++i)
+        if (std::string(hwy::TargetName(targets[i].target)) == name) index = i;
+    current_index.store(index);
+    chosen.store(true);
   });
 }
 
@@ -254,23 +308,21 @@ void chooseOnce() {
 
 std::vector<std::string> trackDepositTargets() {
   std::vector<std::string> names;
-  for (const std::int64_t t : hwy::SupportedAndGeneratedTargets()) names.emplace_back(hwy::TargetName(t));
+  for (const CompiledTarget& t : runnableTargets()) names.emplace_back(hwy::TargetName(t.target));
   return names;
 }
 
 std::string trackDepositTarget() {
   chooseOnce();
-  return hwy::TargetName(current_target.load());
+  return hwy::TargetName(runnableTargets()[current_index.load()].target);
 }
 
 void setTrackDepositTarget(const std::string& name) {
-  if (name.empty() || name == "best") {
-    chooseTarget(bestTarget());
-    return;
-  }
-  for (const std::int64_t t : hwy::SupportedAndGeneratedTargets())
-    if (name == hwy::TargetName(t)) {
-      chooseTarget(t);
+  const std::vector<CompiledTarget>& targets = runnableTargets();
+  for (std::size_t i = 0; i < targets.size(); ++i)
+    if (name.empty() || name == "best" || name == hwy::TargetName(targets[i].target)) {
+      current_index.store(i);
+      chosen.store(true);
       return;
     }
   std::string known;
@@ -282,6 +334,7 @@ void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<Pat
                         const GridSpec& grid, const ReceiverMap* receiver, std::vector<DepositSum>& sums,
                         std::vector<std::vector<std::uint32_t>>& by_slab) {
   chooseOnce();
+  const DepositSlabFn deposit = runnableTargets()[current_index.load()].deposit;
   const std::size_t count = results.size();
   const glm::dvec3 h = grid.voxelSize();
   // Slabs of z-slices, and the patches whose hats reach each one (in patch order). The slabs do
@@ -306,8 +359,8 @@ void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<Pat
       by_slab[static_cast<std::size_t>(slab)].push_back(static_cast<std::uint32_t>(i));
   }
   parallelFor(0, slabs, [&](std::int64_t slab) {
-    HWY_DYNAMIC_DISPATCH(depositSlab)(patches, results, grid, receiver, sums.data(),
-                                      by_slab[static_cast<std::size_t>(slab)], static_cast<int>(slab), slab_depth);
+    deposit(patches, results, grid, receiver, sums.data(), by_slab[static_cast<std::size_t>(slab)], static_cast<int>(slab),
+            slab_depth);
   });
 }
 

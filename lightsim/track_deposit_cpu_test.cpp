@@ -7,6 +7,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <initializer_list>
+#include <set>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "core/error.h"
@@ -178,6 +183,41 @@ TEST_F(TrackDepositCpu, SameBitsWhateverTheThreadCount) {
     }
     ASSERT_EQ(std::memcmp(one.data(), three.data(), one.size() * sizeof(DepositSum)), 0);
   }
+}
+
+// The targets offered are those whose instructions this CPU has, read independently of the
+// dispatch from the kernel's /proc/cpuinfo flags (Linux x86 only): Highway's x86 targets need SSE4
+// (with SSSE3, CLMUL and AES), AVX2 (with AVX, FMA, BMI1/2, F16C and LZCNT, "abm") and AVX3
+// (AVX-512 F, VL, DQ, BW) — a target listed that the CPU lacks would crash the bake — best first,
+// the portable one always last, and "best" the first.
+TEST_F(TrackDepositCpu, TheTargetsOfferedAreThoseThisCpuRunsBestFirst) {
+  const std::vector<std::string> targets = trackDepositTargets();
+  ASSERT_FALSE(targets.empty());
+  EXPECT_TRUE(targets.back() == "SCALAR" || targets.back() == "EMU128") << targets.back();
+  setTrackDepositTarget("best");
+  EXPECT_EQ(trackDepositTarget(), targets.front());
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(cpuinfo, line) && line.rfind("flags", 0) != 0) {
+  }
+  if (line.empty()) GTEST_SKIP() << "no /proc/cpuinfo flags here";
+  std::istringstream words(line);
+  std::set<std::string> flags;
+  for (std::string w; words >> w;) flags.insert(w);
+  auto has = [&](std::initializer_list<const char*> names) {
+    return std::all_of(names.begin(), names.end(), [&](const char* n) { return flags.count(n) > 0; });
+  };
+  const bool sse4 = has({"ssse3", "sse4_1", "sse4_2", "pclmulqdq", "aes"});
+  const bool avx2 = sse4 && has({"avx", "avx2", "fma", "bmi1", "bmi2", "f16c", "abm"});
+  const bool avx3 = avx2 && has({"avx512f", "avx512vl", "avx512dq", "avx512bw"});
+  auto offered = [&](const char* name) { return std::find(targets.begin(), targets.end(), name) != targets.end(); };
+  EXPECT_EQ(offered("SSE4"), sse4);
+  EXPECT_EQ(offered("AVX2"), avx2);
+  EXPECT_EQ(offered("AVX3"), avx3);
+  // Best first: the widest first, in Highway's order.
+  const std::vector<std::string> order = {"AVX3", "AVX2", "SSE4", "SCALAR", "EMU128"};
+  auto rank = [&](const std::string& t) { return std::find(order.begin(), order.end(), t) - order.begin(); };
+  for (std::size_t i = 1; i < targets.size(); ++i) EXPECT_LT(rank(targets[i - 1]), rank(targets[i]));
 }
 
 TEST_F(TrackDepositCpu, AnUnknownTargetIsAClearError) {
