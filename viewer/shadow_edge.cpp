@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <type_traits>
 
 #include "core/half_float.h"
@@ -373,9 +374,19 @@ std::vector<Out> texelsOf(const ReceiverLayer& layer, const std::vector<float>& 
       0, ny,
       [&](std::int64_t row) {
         const int j = static_cast<int>(row);
+        const std::size_t first = static_cast<std::size_t>(j) * static_cast<std::size_t>(nx);
+        // The row as floats (into the output, or a buffer the halves are made from at once).
+        thread_local std::vector<float> buffer;
+        float* out_row = nullptr;
+        if constexpr (std::is_same_v<Out, float>) {
+          out_row = &rgba[4 * first];
+        } else {
+          buffer.resize(4 * static_cast<std::size_t>(nx));
+          out_row = buffer.data();
+        }
         for (int i = 0; i < nx; ++i) {
-          const std::size_t t = static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i);
-          float out[4];
+          const std::size_t t = first + static_cast<std::size_t>(i);
+          float* out = out_row + 4 * static_cast<std::size_t>(i);
           for (int k = 0; k < 3; ++k) out[k] = map.irradiance[3 * t + static_cast<std::size_t>(k)];
           out[3] = edges ? clearance[t] : 1.0f;
           if (!layer.other_lights.empty()) {
@@ -387,11 +398,9 @@ std::vector<Out> texelsOf(const ReceiverLayer& layer, const std::vector<float>& 
             const glm::dvec3 D = bakedDirectIrradiance(layer, map.texelCenter(i, j), normal);
             for (int k = 0; k < 3; ++k) out[k] += static_cast<float>(D[k] * shaded);
           }
-          for (int k = 0; k < 4; ++k) {
-            if constexpr (std::is_same_v<Out, float>) rgba[4 * t + static_cast<std::size_t>(k)] = out[k];
-            else rgba[4 * t + static_cast<std::size_t>(k)] = toHalf(out[k]);
-          }
         }
+        if constexpr (!std::is_same_v<Out, float>)
+          toHalf(std::span<const float>(buffer), std::span<std::uint16_t>(&rgba[4 * first], buffer.size()));
       },
       16);
   return rgba;

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "core/half_float.h"
 #include "lightsim/test_scenes.h"
 
 namespace eik {
@@ -167,6 +168,10 @@ TEST(ShadowEdge, TheGroundShowsTheEdgeWhereTheClearanceChangesSign) {
   layer.light_power = glm::dvec3(D);
   const std::vector<float> texels = receiverTexels(layer, clearance);
   ASSERT_EQ(texels.size(), 4 * map.texelCount());
+  // What the viewer uploads: the same texels as halves (row by row through the span conversion).
+  const std::vector<std::uint16_t> halves = receiverTexelsHalf(layer, clearance);
+  ASSERT_EQ(halves.size(), texels.size());
+  for (std::size_t k = 0; k < texels.size(); ++k) ASSERT_EQ(halves[k], toHalf(texels[k])) << k;
   // Texel 3 (u in [0.3, 0.4)) is the one the edge crosses: lit 7/10 of it; the 8×8 points find
   // 6/8 (those at u ≥ 0.33), so it gets D·(1 − 0.75) back. The others: nothing in the light, D
   // in the shadow.
