@@ -29,7 +29,11 @@ double interfaceBand(const GridSpec& grid) {
   return kInterfaceBandVoxels * std::max(h.x, std::max(h.y, h.z));
 }
 
-Volume buildVolume(const std::vector<Region>& regions, const GridSpec& grid, const PipelineOptions& options) {
+namespace {
+
+// buildVolume; `releasable` (the same regions, or null) gives up each array once read.
+Volume buildFrom(const std::vector<Region>& regions, std::vector<Region>* releasable, const GridSpec& grid,
+                 const PipelineOptions& options) {
   // Progress: compositing is about half the work, smoothing and the gradient the rest.
   auto report = [&options](double from, double to) -> ProgressFn {
     if (!options.progress) return {};
@@ -39,7 +43,9 @@ Volume buildVolume(const std::vector<Region>& regions, const GridSpec& grid, con
   composite.all_fields = options.all_fields;
   composite.progress = report(0.0, 0.5);
   if (options.interfaces == InterfaceMode::Sharp) {
-    Volume volume = buildSharpVolume(regions, grid, options.band > 0.0 ? options.band : interfaceBand(grid), composite);
+    const double band = options.band > 0.0 ? options.band : interfaceBand(grid);
+    Volume volume = releasable ? buildSharpVolume(std::move(*releasable), grid, band, composite)
+                               : buildSharpVolume(regions, grid, band, composite);
     if (options.progress) options.progress(1.0);
     return volume;
   }
@@ -58,6 +64,16 @@ Volume buildVolume(const std::vector<Region>& regions, const GridSpec& grid, con
   volume.metadata["ior_gradient"] = gradientOperatorName(options.gradient);
   if (options.progress) options.progress(1.0);
   return volume;
+}
+
+}  // namespace
+
+Volume buildVolume(const std::vector<Region>& regions, const GridSpec& grid, const PipelineOptions& options) {
+  return buildFrom(regions, nullptr, grid, options);
+}
+
+Volume buildVolume(std::vector<Region>&& regions, const GridSpec& grid, const PipelineOptions& options) {
+  return buildFrom(regions, &regions, grid, options);
 }
 
 namespace {
@@ -236,7 +252,7 @@ Volume buildFields(std::vector<Region>& regions, const GridSpec& grid, const Vox
   pipeline.smooth_sigma_voxels = o.smooth;
   ProgressBar fields_bar("n and grad n", !o.quiet);
   pipeline.progress = fields_bar.callback();
-  Volume volume = buildVolume(regions, grid, pipeline);
+  Volume volume = buildVolume(std::move(regions), grid, pipeline);
   fields_bar.finish();
   regions.clear();
   stats["time_fields_s"] = clock.seconds();

@@ -37,6 +37,8 @@ struct PipelineOptions {
 // linearly, so blocky edges do not bend rays).
 // metadata["ior_smoothing_sigma_voxels"] records σ, metadata["ior_gradient"] the operator.
 Volume buildVolume(const std::vector<Region>& regions, const GridSpec& grid, const PipelineOptions& options = {});
+// The same, releasing the regions' arrays as soon as they are read (sharp: see buildSharpVolume).
+Volume buildVolume(std::vector<Region>&& regions, const GridSpec& grid, const PipelineOptions& options = {});
 
 // The default band of the sharp interfaces' distance field: kInterfaceBandVoxels of the largest
 // voxel edge, in world units.

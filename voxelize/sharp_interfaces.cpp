@@ -118,8 +118,15 @@ SlotAssignment assignInterfaceSlots(const std::vector<Region>& regions, double b
   return result;
 }
 
-Volume buildSharpVolume(const std::vector<Region>& regions, const GridSpec& grid, double band,
-                        const CompositeOptions& options) {
+namespace {
+
+// buildSharpVolume; `releasable` (the same regions, or null) gives up each array once read.
+Volume buildSharp(const std::vector<Region>& regions, std::vector<Region>* releasable, const GridSpec& grid,
+                  double band, const CompositeOptions& options) {
+  auto release = [&](std::vector<float> Region::*array) {
+    if (releasable)
+      for (Region& r : *releasable) std::vector<float>().swap(r.*array);
+  };
   const std::size_t count = grid.count();
   for (const Region& r : regions) {
     if (r.distance.size() != count)
@@ -131,6 +138,7 @@ Volume buildSharpVolume(const std::vector<Region>& regions, const GridSpec& grid
   const int slot_count = static_cast<int>(slots.table.slots.size());
 
   Volume volume = compositeRegions(regions, grid, options);
+  release(&Region::coverage);  // read by compositing only (a region's `ior` says it is graded: kept)
 
   // Slot distances: the union (min) of their regions, one per slot (docs/volume-format.md).
   const std::size_t stride = static_cast<std::size_t>(std::max(slot_count, 1));
@@ -147,6 +155,7 @@ Volume buildSharpVolume(const std::vector<Region>& regions, const GridSpec& grid
       slot = std::min(slot, d[v]);
     }
   }
+  release(&Region::distance);
 
   // n, B and the material label at the voxel centres.
   Field& ior = volume.fields.at("ior");
@@ -208,6 +217,17 @@ Volume buildSharpVolume(const std::vector<Region>& regions, const GridSpec& grid
   volume.metadata["ior_gradient"] = slot_count > 0 && !any_graded ? "left out: no graded material (sharp interfaces)"
                                                                    : "graded materials only (sharp interfaces)";
   return volume;
+}
+
+}  // namespace
+
+Volume buildSharpVolume(const std::vector<Region>& regions, const GridSpec& grid, double band,
+                        const CompositeOptions& options) {
+  return buildSharp(regions, nullptr, grid, band, options);
+}
+
+Volume buildSharpVolume(std::vector<Region>&& regions, const GridSpec& grid, double band, const CompositeOptions& options) {
+  return buildSharp(regions, &regions, grid, band, options);
 }
 
 }  // namespace eik

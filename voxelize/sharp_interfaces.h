@@ -37,5 +37,10 @@ SlotAssignment assignInterfaceSlots(const std::vector<Region>& regions, double b
 // `ior_at_center`), grid.count() long; std::invalid_argument otherwise.
 Volume buildSharpVolume(const std::vector<Region>& regions, const GridSpec& grid, double band,
                         const CompositeOptions& options = {});
+// The same, releasing each region's arrays once they are read (coverage after compositing, the
+// distances once the slots hold them), so that the volume's own fields reuse their memory: at 128³
+// a full-grid array (9 MB) less at the peak. The regions keep their names and materials.
+Volume buildSharpVolume(std::vector<Region>&& regions, const GridSpec& grid, double band,
+                        const CompositeOptions& options = {});
 
 }  // namespace eik

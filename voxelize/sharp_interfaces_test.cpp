@@ -121,6 +121,34 @@ TEST(SharpInterfaces, FieldsAreSharpDistancesAndUnblendedN) {
 // Objects that need no interface (n = 1, nothing opaque): the volume has no interfaces field and
 // no table, which readers would refuse as "0 slots" (voxelize wrote such a volume that lightsim and
 // the viewer could not open).
+// Handed over (an rvalue), the regions give up their coverage and distances once read, and the
+// volume is the one the const form builds, every field to the bit: several materials sharing slots,
+// an absorbing one, smoke and a graded lens (whose n, kept, still says it is graded).
+TEST(SharpInterfaces, HandedOverRegionsReleaseTheirArraysAndBuildTheSameVolume) {
+  const GridSpec g = cube(24, 0.6);
+  const std::vector<std::string> specs = {"procedural:sphere,r=0.45,ior=1.5,sigma_a=0.5:0.2:0.1",
+                                          "procedural:sphere,r=0.15,center=0.2:0:0,ior=1.33,name=wine",
+                                          "procedural:gradient_slab,size=0.2:0.2:0.2,center=-0.2:0:0,n0=1.3,n1=1.7",
+                                          "procedural:box,size=1.1,ior=1,scatter=0.3,name=smoke"};
+  const std::vector<Region> kept = regionsOf(specs, g);
+  const Volume expected = buildSharpVolume(kept, g, interfaceBand(g));
+  std::vector<Region> handed = regionsOf(specs, g);
+  const Volume got = buildSharpVolume(std::move(handed), g, interfaceBand(g));
+  ASSERT_EQ(handed.size(), kept.size());
+  for (std::size_t i = 0; i < handed.size(); ++i) {
+    EXPECT_TRUE(handed[i].coverage.empty()) << handed[i].name;
+    EXPECT_TRUE(handed[i].distance.empty()) << handed[i].name;
+    EXPECT_EQ(handed[i].ior.empty(), kept[i].ior.empty()) << handed[i].name;
+  }
+  ASSERT_EQ(got.fields.size(), expected.fields.size());
+  for (const auto& [name, field] : expected.fields) {
+    ASSERT_TRUE(got.has(name)) << name;
+    EXPECT_EQ(got.fields.at(name).components, field.components) << name;
+    EXPECT_TRUE(got.fields.at(name).data == field.data) << name;
+  }
+  EXPECT_EQ(got.metadata, expected.metadata);
+}
+
 TEST(SharpInterfaces, ObjectsOfAirMakeAVolumeWithoutInterfaces) {
   const GridSpec g = cube(16, 0.6);
   const Volume v = buildSharpVolume(regionsOf({"procedural:box,size=0.5:0.5:0.5,ior=1.0"}, g), g, interfaceBand(g));
