@@ -252,10 +252,12 @@ int run(int argc, char** argv) {
   }
 
   // The ground's texels on the CPU while the driver may still be loading, then the context.
-  const SceneRenderer::Preparation prepared = SceneRenderer::prepare(scene);
+  SceneRenderer::Preparation prepared = SceneRenderer::prepare(scene);
+  SceneRenderer::releasePrepared(scene, prepared);
   gl::GlContext context(context_options);
   gl::ShaderLibrary shaders;
   SceneRenderer renderer(shaders, scene, settings, &prepared);
+  prepared = {};  // uploaded: the render's own memory reuses it
   Image image = renderer.render(camera, size);
   ImageWriteOptions write;
   write.exposure_ev = exposure_ev;

@@ -447,6 +447,15 @@ SceneRenderer::Preparation SceneRenderer::prepare(const LoadedScene& scene) {
   return prepared;
 }
 
+void SceneRenderer::releasePrepared(LoadedScene& scene, const Preparation& prepared) {
+  // Only a lone object's map (attachReceiver keeps the maps of a ground map of several).
+  if (scene.objects.size() != 1 || !scene.scene.ground || prepared.ground_texels.empty() || !prepared.ground_texels[0]) return;
+  LoadedObject& object = scene.objects[0];
+  const Impl::GroundReceiver found = Impl::findGroundReceiver(object, *scene.scene.ground);
+  for (ReceiverMap& map : object.volume.receivers)
+    if (&map == found.map) std::vector<float>().swap(map.irradiance);
+}
+
 SceneRenderer::SceneRenderer(const gl::ShaderLibrary& shaders, const LoadedScene& scene, const RenderSettings& settings,
                              const Preparation* prepared)
     : impl_(std::make_unique<Impl>(shaders, scene)) {

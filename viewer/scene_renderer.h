@@ -42,6 +42,11 @@ class SceneRenderer {
     std::vector<std::optional<std::vector<std::uint16_t>>> ground_texels;  // per object, RGBA16F; none: no map
   };
   static Preparation prepare(const LoadedScene& scene);
+  // Gives up what the renderer will not read once `prepared` holds it: a lone object's receiver map
+  // irradiance (made into its texels; a ground map of two or more objects reads the maps
+  // themselves, so theirs are kept). The textures uploaded next reuse its memory (12 MB at 1024²
+  // texels). The headless viewer calls it; a window, which may re-bake, keeps its maps.
+  static void releasePrepared(LoadedScene& scene, const Preparation& prepared);
 
   SceneRenderer(const gl::ShaderLibrary& shaders, const LoadedScene& scene, const RenderSettings& settings,
                 const Preparation* prepared = nullptr);

@@ -371,6 +371,18 @@ TEST_F(SharpViewerTest, GroundTexelsPreparedBeforehandRenderTheSameImage) {
   const Image with = SceneRenderer(*shaders_, loaded, RenderSettings{}, &prepared).render(camera, {64, 64});
   ASSERT_EQ(with.pixels.size(), without.pixels.size());
   EXPECT_EQ(with.pixels, without.pixels);
+  // The headless viewer then gives up the lone object's map irradiance (its texels hold it): the
+  // renderer built after that renders the same image.
+  LoadedScene released = loaded;
+  SceneRenderer::releasePrepared(released, prepared);
+  EXPECT_TRUE(released.objects[0].volume.receivers.at(0).irradiance.empty());
+  const Image after = SceneRenderer(*shaders_, released, RenderSettings{}, &prepared).render(camera, {64, 64});
+  EXPECT_EQ(after.pixels, without.pixels);
+  // Two objects keep their maps: a ground map of both reads them.
+  LoadedScene two = sceneFromVolumes(floorScene(2), {volume, volume});
+  const SceneRenderer::Preparation prepared_two = SceneRenderer::prepare(two);
+  SceneRenderer::releasePrepared(two, prepared_two);
+  for (const LoadedObject& object : two.objects) EXPECT_FALSE(object.volume.receivers.at(0).irradiance.empty());
   // A scene without a ground has nothing to prepare.
   loaded.scene.ground.reset();
   EXPECT_FALSE(SceneRenderer::prepare(loaded).ground_texels.at(0).has_value());
