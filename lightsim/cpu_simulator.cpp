@@ -582,6 +582,9 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
 
 CpuSimulator::CpuSimulator(const Volume& volume) : sampler_(volume) {}
 
+CpuSimulator::CpuSimulator(const Volume& volume, std::vector<float>* interfaces_data)
+    : sampler_(volume, interfaces_data) {}
+
 int exitFace(const glm::dvec3& m, const glm::dvec3& d, const GridSpec& grid) {
   const glm::dvec3 lo = grid.bounds_min, hi = grid.bounds_max;
   // Slab test of the backward ray m − t·d: the face of the largest entry parameter.

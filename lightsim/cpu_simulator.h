@@ -35,6 +35,9 @@ class CpuSimulator : public Simulator {
   // Copies what it needs of the volume (n, ∇n, σa; see VolumeSampler): the volume may go away.
   // Throws InputError when `ior` or `ior_grad` is missing or malformed.
   explicit CpuSimulator(const Volume& volume);
+  // The same, taking the `interfaces` field's data where the sampler keeps it as it is
+  // (VolumeSampler(const Volume&, std::vector<float>*)); null: copies it.
+  CpuSimulator(const Volume& volume, std::vector<float>* interfaces_data);
 
   // Runs one bake. Throws InputError for a bad light or bad options (validateOptions). A light that
   // misses the volume gives all-zero fields and stats.initial_patches = 0 (lightMissedVolume).

@@ -626,6 +626,46 @@ TEST(CpuSimulator, MergedStraightStepsKeepTheVolumeLight) {
               luminance(b.stats.flux_absorbed + b.stats.flux_out + b.stats.flux_reflected), 2e-3 * luminance(b.stats.flux_in));
 }
 
+// The CPU twin given the `interfaces` field's data to take (what lightsim does with the volume it
+// then drops) takes it, leaving the field empty, and bakes what the one that copied it bakes, to the
+// bit: the map, the volume light, the patch-steps; in absorbing glass too, whose σa per material is
+// found from the field's distances (before they are taken). A field the sampler does not keep as it
+// is (four slots' distances, two of them used) is copied, and left as it was.
+TEST(CpuSimulator, TakingTheDistancesBakesWhatCopyingThemBakes) {
+  LightSpec light;
+  light.direction = glm::normalize(glm::dvec3(0.3, -1.0, 0.2));
+  SimulationOptions o;
+  o.receiver = test_scenes::floorAt(-0.7, 1.5);
+  o.volume_deposits = true;
+  for (const char* spec : {"procedural:sphere,r=0.5,ior=1.5", "procedural:sphere,r=0.5,ior=1.5,sigma_a=1:2:0.5"}) {
+    SCOPED_TRACE(spec);
+    const Volume whole = sharpVolume(spec, 20, cube(0.6));
+    Volume donor = whole;
+    std::vector<float>& data = donor.fields.at("interfaces").data;
+    ASSERT_EQ(donor.fields.at("interfaces").components, 1);
+    const BakeResult a = CpuSimulator(whole).run(light, o);
+    CpuSimulator taker(donor, &data);
+    EXPECT_TRUE(data.empty()) << "taken, not copied";
+    const BakeResult b = taker.run(light, o);
+    ASSERT_EQ(a.receivers.size(), 1u);
+    ASSERT_EQ(b.receivers.size(), 1u);
+    EXPECT_EQ(a.receivers[0].irradiance, b.receivers[0].irradiance);
+    EXPECT_EQ(a.irradiance.data, b.irradiance.data);
+    EXPECT_EQ(a.stats.total_patches, b.stats.total_patches);
+    EXPECT_EQ(luminance(a.stats.flux_absorbed), luminance(b.stats.flux_absorbed));
+  }
+  // Four distances a voxel (the older layout), one slot used: the sampler keeps one of them, so it
+  // copies, and the field is left whole.
+  Volume four = sharpVolume("procedural:sphere,r=0.5,ior=1.5", 16, cube(0.6));
+  Field& distances = four.fields.at("interfaces");
+  std::vector<float> wide(4 * distances.data.size(), static_cast<float>(interfaceTable(four).band));
+  for (std::size_t i = 0; i < distances.data.size(); ++i) wide[4 * i] = distances.data[i];
+  distances.data = wide;
+  distances.components = 4;
+  const CpuSimulator copier(four, &distances.data);
+  EXPECT_EQ(distances.data, wide);
+}
+
 // In a volume whose sharp materials all have a constant n no sample reads the n and ∇n fields
 // (lightsim leaves them unread: VolumeReadOptions): without them the bake is the same to the bit;
 // with a graded material they are needed, and their absence is named.

@@ -240,8 +240,11 @@ int run(int argc, char** argv) {
     std::unique_ptr<Simulator> simulator;  // one band: one simulator for every run
     const Volume& atScale() const { return scaled ? *scaled : *volume; }
   };
+  // `fields_go`: the caller drops the volume's fields once the simulator is made (the command's one
+  // volume: written back from their files), so the CPU twin may take the distances it keeps as they are.
   auto prepare = [&](Volume& volume, const std::string& source, const std::vector<BakeLight>& lights,
-                     SimulationOptions options, double scale, const std::vector<SpectralBand>& bands) {
+                     SimulationOptions options, double scale, const std::vector<SpectralBand>& bands,
+                     bool fields_go = false) {
     auto bake = std::make_unique<VolumeBake>();
     bake->volume = &volume;
     bake->source = source;
@@ -299,7 +302,13 @@ int run(int argc, char** argv) {
       propagationBox(bake->atScale().grid, options, lo, hi);
       options.receiver_geometry = receiverGeometry(*options.receiver, point_like, bake->atScale().grid, lo, hi);
     }
-    if (bands.size() == 1) bake->simulator = makeSimulator(bake->atScale(), choice, &options);
+    if (bands.size() == 1) {
+      SimulatorBackendOptions made = choice;
+      const auto interfaces = volume.fields.find("interfaces");
+      if (fields_go && !bake->scaled && interfaces != volume.fields.end() && volume.field_files.count("interfaces") > 0)
+        made.cpu_takes_interfaces = &interfaces->second.data;
+      bake->simulator = makeSimulator(bake->atScale(), made, &options);
+    }
     bake->options = options;
     return bake;
   };
@@ -573,9 +582,9 @@ int run(int argc, char** argv) {
   iorGradient(volume, interfaceTable(volume, input), input);
   const std::vector<SpectralBand> bands = isDispersive(volume) ? spectralBands(band_count) : spectralBands(1);
   const std::vector<BakeLight> lights = bakeLights(lights_to_bake);
-  std::unique_ptr<VolumeBake> bake = prepare(volume, input, lights, options, 1.0, bands);
-  // The simulator (one band: made once) holds its own copy of every field it samples. The volume's
-  // fields go now, as if left unread: writeVolume carries their files into the output as they are,
+  std::unique_ptr<VolumeBake> bake = prepare(volume, input, lights, options, 1.0, bands, true);
+  // The simulator (one band: made once) holds its own copy of every field it samples (the CPU twin
+  // took the distances' data itself). The volume's fields go now, as if left unread: writeVolume carries their files into the output as they are,
   // and the bake's own memory reuses theirs instead of fresh pages (at 128³ the sphere's distances,
   // 9 MB).
   if (bake->simulator)

@@ -38,7 +38,7 @@ std::unique_ptr<Simulator> makeSimulator(const Volume& volume, const SimulatorBa
       throw InputError("--backend", "gl", "the GPU path does not do " + lacks + " yet: use --backend cpu or auto");
     if (backend == SimulatorBackend::Auto) {
       if (options.report) options.report("the GPU path does not do " + lacks + " yet, so the CPU twin");
-      return std::make_unique<CpuSimulator>(volume);
+      return std::make_unique<CpuSimulator>(volume, options.cpu_takes_interfaces);
     }
   }
   // Auto: probe the OpenGL renderer; a hardware context stays alive for the GPU path.
@@ -53,12 +53,12 @@ std::unique_ptr<Simulator> makeSimulator(const Volume& volume, const SimulatorBa
       // no hardware OpenGL whatever the back end.
       if (gl::resolveGlBackend(context.backend) == gl::GlBackend::OSMesa) {
         if (options.report) options.report("OSMesa renders in software, so the CPU twin (faster than a software rasterizer)");
-        return std::make_unique<CpuSimulator>(volume);
+        return std::make_unique<CpuSimulator>(volume, options.cpu_takes_interfaces);
       }
       if (!gl::gpuDevicePresent()) {
         if (options.report)
           options.report("no GPU device (/dev/dri/renderD*, /dev/nvidia0), so the CPU twin");
-        return std::make_unique<CpuSimulator>(volume);
+        return std::make_unique<CpuSimulator>(volume, options.cpu_takes_interfaces);
       }
       probe = std::make_unique<gl::GlContext>(context);
       if (!gl::isSoftwareRenderer(probe->info())) backend = SimulatorBackend::Gl;
@@ -70,7 +70,7 @@ std::unique_ptr<Simulator> makeSimulator(const Volume& volume, const SimulatorBa
     }
     if (backend == SimulatorBackend::Cpu) probe.reset();
   }
-  if (backend == SimulatorBackend::Cpu) return std::make_unique<CpuSimulator>(volume);
+  if (backend == SimulatorBackend::Cpu) return std::make_unique<CpuSimulator>(volume, options.cpu_takes_interfaces);
   GpuSimulatorOptions gpu;
   gpu.source = options.source;
   gpu.backend = gl::parseGlBackend(options.gl);

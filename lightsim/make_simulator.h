@@ -13,6 +13,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/volume.h"
 #include "lightsim/gpu_simulator.h"
@@ -34,6 +35,10 @@ struct SimulatorBackendOptions {
   // Auto only: told which back end was chosen and why, e.g. "llvmpipe (LLVM 15.0.6, 256 bits), so
   // the CPU twin (faster than a software rasterizer)" or "no OpenGL context (...), so the CPU twin".
   std::function<void(const std::string&)> report;
+  // The CPU twin may take this data of the volume's `interfaces` field instead of copying it
+  // (VolumeSampler): given by a caller that needs the field no more (`lightsim`, which writes it
+  // back from its file); the GPU path leaves it.
+  std::vector<float>* cpu_takes_interfaces = nullptr;
 };
 
 // Whether makeSimulator takes the CPU twin whatever the volume, known before any driver is loaded:

@@ -118,7 +118,9 @@ glm::dvec4 sampleTrilinear(const Field& field, const GridSpec& grid, const glm::
   return out;
 }
 
-VolumeSampler::VolumeSampler(const Volume& volume)
+VolumeSampler::VolumeSampler(const Volume& volume) : VolumeSampler(volume, nullptr) {}
+
+VolumeSampler::VolumeSampler(const Volume& volume, std::vector<float>* interfaces_data)
     : grid_(volume.grid), h_(voxelEdge(volume.grid)), tap_scale_(tapScale(volume.grid)) {
   const std::size_t n = grid_.count();
   // The copies below, in chunks of voxels in parallel.
@@ -147,14 +149,33 @@ VolumeSampler::VolumeSampler(const Volume& volume)
       }
     });
   }
+  if (const Field* sa = volume.find("sigma_a")) {
+    if (sa->components != 3) throw InputError("volume", "sigma_a", "expected 3 components");
+    bool any = false;
+    for (float v : sa->data) any = any || v != 0.0f;
+    if (any) {
+      sigma_a_.resize(n);
+      for (std::size_t i = 0; i < n; ++i) sigma_a_[i] = glm::vec3(sa->voxel(i)[0], sa->voxel(i)[1], sa->voxel(i)[2]);
+    }
+  }
+  findMaterialAbsorption(volume);  // reads the volume's distances: before they may be taken below
   const Field* d = nullptr;
+  const float* dist_data = nullptr;  // d's distances, `dist_stride` floats a voxel
+  std::size_t dist_stride = 0;
   std::vector<std::uint8_t> slot_signs;  // while the tables are built
   if (!table_.empty()) {
     d = volume.find("interfaces");  // one distance per slot, or four (interfaceTable checked which)
     const int used = slotCount();
     const std::optional<float> unused = unusedSlotDistance(*d, used, table_.band);
     unused_distance_ = unused.value_or(0.0f);
-    if (unused) {
+    // Where the distances are read below: the field's, or the sampler's own once it took them.
+    dist_data = d->data.data();
+    dist_stride = static_cast<std::size_t>(d->components);
+    if (unused && interfaces_data == &d->data && d->components == used) {
+      used_distances_ = std::move(*interfaces_data);  // the same layout: taken, not copied
+      dist_data = used_distances_.data();
+      dist_stride = static_cast<std::size_t>(used);
+    } else if (unused) {
       used_distances_.resize(n * static_cast<std::size_t>(used));
       forChunks([&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i)
@@ -174,8 +195,8 @@ VolumeSampler::VolumeSampler(const Volume& volume)
     // materials here and the quiet bricks below, which compare them between neighbours.
     slot_signs = std::vector<std::uint8_t>(n);
     forChunks([&](std::size_t begin, std::size_t end) {
-      const float* data = d->data.data();
-      const std::size_t stride = static_cast<std::size_t>(d->components);
+      const float* data = dist_data;
+      const std::size_t stride = dist_stride;
       for (std::size_t i = begin; i < end; ++i) {
         std::uint8_t bits = 0;
         for (int k = 0; k < used; ++k) {
@@ -215,23 +236,13 @@ VolumeSampler::VolumeSampler(const Volume& volume)
       }
     });
   }
-  if (const Field* sa = volume.find("sigma_a")) {
-    if (sa->components != 3) throw InputError("volume", "sigma_a", "expected 3 components");
-    bool any = false;
-    for (float v : sa->data) any = any || v != 0.0f;
-    if (any) {
-      sigma_a_.resize(n);
-      for (std::size_t i = 0; i < n; ++i) sigma_a_[i] = glm::vec3(sa->voxel(i)[0], sa->voxel(i)[1], sa->voxel(i)[2]);
-    }
-  }
-  findMaterialAbsorption(volume);
   // The quiet bricks, from the volume's own fields (what the copies above would give).
   QuietMap::FieldViews views;
   views.ior = ior ? ior->data.data() : nullptr;  // read only in graded materials (QuietMap)
   views.grad = grad ? grad->data.data() : nullptr;
   if (d) {
-    views.distances = d->data.data();
-    views.distances_stride = static_cast<std::size_t>(d->components);
+    views.distances = dist_data;
+    views.distances_stride = dist_stride;
     views.slot_signs = slot_signs.data();
   }
   if (!sigma_a_.empty()) views.sigma_a = &sigma_a_[0].x;

@@ -104,6 +104,10 @@ class VolumeSampler {
   // (no graded slot), where no sample reads them; `sigma_a` (3) is optional (absent: σa = 0).
   // Throws InputError naming the field otherwise.
   explicit VolumeSampler(const Volume& volume);
+  // The same, taking the data of the volume's `interfaces` field instead of copying it where the
+  // sampler keeps it as it is (one used slot per component): `interfaces_data` must be that field's
+  // data, which is left empty (a full-grid array less: 9 MB at 132³). Otherwise it is copied.
+  VolumeSampler(const Volume& volume, std::vector<float>* interfaces_data);
 
   const GridSpec& grid() const { return grid_; }
   double h() const { return h_; }
