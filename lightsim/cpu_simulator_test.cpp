@@ -907,6 +907,76 @@ TEST(CpuSimulator, StraightStepsMergeUpToTheOneThatMeetsAnInterface) {
   EXPECT_NEAR(above().midpoint().y - one.midpoint().y, single_ctx.step_dt, 1e-12);
 }
 
+// A reflected wavefront's straight steps (8 voxels) are longer than this slab is thick (2.4 voxels):
+// the step that passes through it ends in air as it began. Looked at in pieces, that step still
+// meets both faces (a Fresnel loss at each), and merged steps stop before it as they stop before
+// any step that meets an interface; asked at its end only, the merged flight went through the
+// slab as if it were not there.
+TEST(CpuSimulator, AReflectedWavefrontsMergedStepsStopAtAWallThinnerThanAStep) {
+  const double top = -0.2, thickness = 0.05;
+  const Volume v = sharpVolume("procedural:box,size=0.8:" + std::to_string(thickness) + ":0.8,center=0:" +
+                                   std::to_string(top - 0.5 * thickness) + ":0,ior=1.5",
+                               48, cube(0.5));
+  const VolumeSampler sampler(v);
+  const QuietMap nowhere_quiet;
+  auto context = [&](const SimulationOptions& options) {
+    StepContext ctx = makeStepContext(sampler, options, 1.0);
+    ctx.quiet = &nowhere_quiet;
+    ctx.flight_cap = 10.0;
+    return ctx;
+  };
+  SimulationOptions merged;
+  merged.free_flight = true;
+  merged.volume_deposits = false;
+  merged.straight_step_voxels = 2.0;  // the command's defaults
+  SimulationOptions single = merged;
+  single.merge_straight_steps = false;
+  const StepContext merged_ctx = context(merged), single_ctx = context(single);
+  const double step = merged_ctx.reflected_step_dt;  // its length in air
+  ASSERT_GT(step, 3.0 * thickness);
+  // Three steps of air above the slab, the fourth from 0.06 above its top to below its bottom.
+  auto above = [&] {
+    Patch patch = squarePatchGoingDown(sampler, 0.01);
+    for (glm::dvec3& x : patch.x) x.y += top + 0.06 + 3.0 * step;
+    for (int c = 0; c < 4; ++c) patch.medium[c] = sampler.materialAt(patch.x[c]);
+    patch.bounce = 1;
+    return patch;
+  };
+  ASSERT_LT(top + 0.06 - step, top - thickness);
+  auto meets = [](const PatchStepResult& r, const Patch& p) { return r.reflected.x > 0.0 || p.medium[0] != -1; };
+  // One straight step at a time: the fourth meets the slab, and leaves it on the far side.
+  Patch stepped = above();
+  ASSERT_EQ(stepped.medium[0], -1);
+  PatchSamples stepped_samples = samplePatch(stepped, sampler);
+  int clear_steps = 0;
+  for (;; ++clear_steps) {
+    Patch next = stepped;
+    PatchSamples next_samples = stepped_samples;
+    const PatchStepResult r = stepPatch(next, next_samples, single_ctx);
+    ASSERT_FALSE(r.flight);
+    if (meets(r, next)) {
+      // Both faces at normal incidence: (1 − R)² with R = (0.5 / 2.5)².
+      EXPECT_NEAR(next.flux.x / stepped.flux.x, (1.0 - 0.04) * (1.0 - 0.04), 1e-9);
+      for (int c = 0; c < 4; ++c) EXPECT_EQ(next.medium[c], -1) << c;
+      break;
+    }
+    stepped = next;
+    stepped_samples = next_samples;
+    ASSERT_LT(clear_steps, 10);
+  }
+  EXPECT_EQ(clear_steps, 3);
+  // Merged: one patch-step to where the three clear steps end, then the step that meets the slab.
+  Patch patch = above();
+  PatchSamples samples = samplePatch(patch, sampler);
+  const PatchStepResult r = stepPatch(patch, samples, merged_ctx);
+  EXPECT_TRUE(r.flight);
+  EXPECT_FALSE(meets(r, patch));
+  for (int c = 0; c < 4; ++c) EXPECT_NEAR(glm::length(patch.x[c] - stepped.x[c]), 0.0, 1e-12) << c;
+  const PatchStepResult crossing = stepPatch(patch, samples, merged_ctx);
+  EXPECT_FALSE(crossing.flight);
+  EXPECT_TRUE(meets(crossing, patch));
+}
+
 // The same over a whole bake: the sphere over a floor and the wine glass (thin walls, a stem) under
 // an oblique sun, baked as lightsim bakes them, with straight steps merged and one at a time. A
 // merged patch-step ends where the steps one at a time would have, unless those steps would have

@@ -107,6 +107,22 @@ bool findInterface(const VolumeSampler& sampler, const glm::dvec3& a, const glm:
   return hit.slot >= 0;
 }
 
+bool findInterfaceOnChord(const VolumeSampler& sampler, const glm::dvec3& a, const glm::dvec3& b, int from,
+                          InterfaceHit& hit) {
+  const int pieces = chordPieces(glm::length(b - a), sampler.h());
+  if (pieces == 1) return findInterface(sampler, a, b, from, hit);
+  const glm::dvec3 piece = (b - a) / static_cast<double>(pieces);
+  for (int j = 0; j < pieces; ++j) {
+    const glm::dvec3 start = a + static_cast<double>(j) * piece;
+    const glm::dvec3 end = j + 1 == pieces ? b : a + static_cast<double>(j + 1) * piece;
+    if (findInterface(sampler, start, end, from, hit)) {
+      hit.fraction = (static_cast<double>(j) + hit.fraction) / static_cast<double>(pieces);
+      return true;
+    }
+  }
+  return false;
+}
+
 Refraction refract(const glm::dvec3& d, const glm::dvec3& normal, double n1, double n2) {
   Refraction r;
   const glm::dvec3 nf = glm::dot(d, normal) < 0.0 ? normal : -normal;  // against the ray
@@ -138,7 +154,7 @@ CornerCrossings advanceCornerSharp(glm::dvec3& x, glm::dvec3& w, int& medium, gl
     glm::dvec3 x1 = x, w1 = w;
     rayStep(x1, w1, sample, remaining, integrator, medium, sampler);
     InterfaceHit hit;
-    if (crossing == kMaxCrossingsPerStep || !findInterface(sampler, x, x1, medium, hit) || hit.entered == medium) {
+    if (crossing == kMaxCrossingsPerStep || !findInterfaceOnChord(sampler, x, x1, medium, hit) || hit.entered == medium) {
       absorb(x, x1);
       x = x1;
       sample = sampler.materialOptics(medium, x);

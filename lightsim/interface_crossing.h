@@ -13,6 +13,9 @@
 // It then goes on for the rest of the step's time (a corner may cross several interfaces per step).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+
 #include <glm/glm.hpp>
 
 #include "lightsim/simulator.h"
@@ -41,6 +44,23 @@ struct InterfaceHit {
   int entered = -1;
 };
 bool findInterface(const VolumeSampler& sampler, const glm::dvec3& a, const glm::dvec3& b, int from, InterfaceHit& hit);
+
+// findInterface asks the chord's end for its material first, so a chord that passes through a
+// wall thinner than itself and ends in its own material meets nothing. A step's chord is therefore
+// looked at in pieces of at most kChordPieceVoxels voxels (a straight step's default length: the
+// ordinary steps stay one piece; a reflected wavefront's steps, kReflectedStepFactor times as
+// long, and longer --straight-step ones are cut up), each asked in turn, nearest first.
+constexpr double kChordPieceVoxels = 2.0;
+// The pieces a chord of `length` is looked at in, h the voxel edge: ⌈length / (kChordPieceVoxels·h)⌉,
+// with a little slack so that a chord of exactly that length (the ordinary straight step in
+// air, up to rounding) stays one piece.
+inline int chordPieces(double length, double h) {
+  const double pieces = std::ceil(length / (kChordPieceVoxels * h) - 1e-6);
+  return pieces > 1.0 ? static_cast<int>(std::min(pieces, 1024.0)) : 1;
+}
+// findInterface on a chord in chordPieces equal pieces; hit.fraction is of the whole chord.
+bool findInterfaceOnChord(const VolumeSampler& sampler, const glm::dvec3& a, const glm::dvec3& b, int from,
+                          InterfaceHit& hit);
 
 // Snell's law and Fresnel at a surface with unit normal `normal` (either orientation) for a ray
 // going along unit `d` from index n1 into n2: the new unit direction, and R (1: total internal

@@ -96,6 +96,9 @@ float mergedStepsTime(Patch p, vec3 v[4], float tMax, bool splitDue) {
   float stepTime = p.bounce > 0 ? uReflectedStepDt : uStepDt;
   int most = int(min(64.0, floor(tMax / stepTime)));
   if (most < 2) return 0.0;
+  // A long step's chord is looked at in pieces (findInterfaceOnChord): so are its ends here.
+  int pieces[4];
+  for (int c = 0; c < 4; ++c) pieces[c] = chordPieces(stepTime * length(v[c]));
   int k = 0;
   bool met = false;
   while (k < most && !met) {
@@ -112,6 +115,8 @@ float mergedStepsTime(Patch p, vec3 v[4], float tMax, bool splitDue) {
     float t = float(k + 1) * stepTime;
     vec3 mid = vec3(0.0);
     for (int c = 0; c < 4; ++c) {
+      for (int j = 1; j < pieces[c]; ++j)
+        if (materialAt(p.x[c] + (float(k) + float(j) / float(pieces[c])) * stepTime * v[c]) != p.medium[c]) met = true;
       vec3 end = p.x[c] + t * v[c];
       if (materialAt(end) != p.medium[c]) met = true;
       mid += 0.25 * end;

@@ -177,6 +177,30 @@ struct CornerCrossings {
   vec3 opticalDepth;    // ∫σa ds, each chord piece with its material's σa (MATERIAL_ABSORPTION)
 };
 
+// The pieces of at most kChordPieceVoxels voxels a chord of `len` is looked at in (chordPieces,
+// interface_crossing.h): one for an ordinary straight step; a reflected wavefront's longer steps
+// are cut up, so that a chord through a wall thinner than itself still meets it.
+const float kChordPieceVoxels = 2.0;
+int chordPieces(float len) {
+  return int(clamp(ceil(len / (kChordPieceVoxels * uVoxelEdge) - 1e-4), 1.0, 1024.0));
+}
+
+// findInterface on the chord a → b in chordPieces equal pieces, nearest first (findInterfaceOnChord);
+// the fraction is of the whole chord.
+bool findInterfaceOnChord(vec3 a, vec3 b, int from, out float fraction, out int slot, out int entered) {
+  int pieces = chordPieces(distance(a, b));
+  if (pieces == 1) return findInterface(a, b, from, fraction, slot, entered);
+  vec3 piece = (b - a) / float(pieces);
+  for (int j = 0; j < pieces; ++j) {
+    vec3 end = j + 1 == pieces ? b : a + float(j + 1) * piece;
+    if (findInterface(a + float(j) * piece, end, from, fraction, slot, entered)) {
+      fraction = (float(j) + fraction) / float(pieces);
+      return true;
+    }
+  }
+  return false;
+}
+
 // advanceCornerSharp: corner (x, w) in `medium` goes on for Δt = dt, stopping at each interface
 // its chord meets (at most kMaxCrossingsPerStep): opaque → stops; past the critical angle →
 // mirrored; else refracted by Snell's law, keeping 1 − R.
@@ -189,7 +213,7 @@ CornerCrossings advanceCornerSharp(inout vec3 x, inout vec3 w, inout int medium,
     materialStep(x1, w1, remaining, medium);
     float f;
     int slot, entered;
-    if (crossing == kMaxCrossingsPerStep || !findInterface(x, x1, medium, f, slot, entered) || entered == medium) {
+    if (crossing == kMaxCrossingsPerStep || !findInterfaceOnChord(x, x1, medium, f, slot, entered) || entered == medium) {
 #ifdef MATERIAL_ABSORPTION
       result.opticalDepth += materialSigmaA(medium) * distance(x, x1);
 #endif

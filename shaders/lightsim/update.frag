@@ -108,7 +108,7 @@ bool willTear(Patch p, int metMask, float reach) {
     float f;
     int k, entered;
     vec3 d = normalize(p.w[c]);
-    if (!findInterface(p.x[c], p.x[c] + reach * d, p.medium[c], f, k, entered)) return true;
+    if (!findInterfaceOnChord(p.x[c], p.x[c] + reach * d, p.medium[c], f, k, entered)) return true;
     if (slot >= 0 && k != slot) return true;
     slot = k;
   }
