@@ -846,24 +846,64 @@ TEST(CpuBench, DISABLED_GlassSphere) {
 // a map with no quiet brick at all), a patch takes at once the straight steps whose ends keep every
 // corner in its own material, and stops at the end of the last of them, exactly where those steps
 // one at a time would have put it; the next step is the one that meets the interface.
-TEST(CpuSimulator, StraightStepsMergeUpToTheOneThatMeetsAnInterface) {
-  // A glass slab, top face at y = −0.15; the patch starts 0.6 above it (14 voxels: 7 straight steps).
-  const Volume v = sharpVolume("procedural:box,size=0.8:0.3:0.8,center=0:-0.3:0,ior=1.5", 24, cube(0.5));
-  const VolumeSampler sampler(v);
-  const QuietMap nowhere_quiet;
-  auto context = [&](const SimulationOptions& options) {
+// The step contexts of the merged-steps tests: the command's straight steps of 2 voxels, merged
+// or one at a time, and no quiet brick anywhere (no flight: merged straight steps only).
+struct MergeContexts {
+  QuietMap nowhere_quiet;
+  SimulationOptions merged, single;
+  StepContext merged_ctx, single_ctx;
+  explicit MergeContexts(const VolumeSampler& sampler) {
+    merged.free_flight = true;
+    merged.volume_deposits = false;
+    merged.straight_step_voxels = 2.0;
+    single = merged;
+    single.merge_straight_steps = false;
+    merged_ctx = context(sampler, merged);
+    single_ctx = context(sampler, single);
+  }
+  MergeContexts(const MergeContexts&) = delete;  // the contexts point at the members
+  MergeContexts& operator=(const MergeContexts&) = delete;
+
+ private:
+  StepContext context(const VolumeSampler& sampler, const SimulationOptions& options) const {
     StepContext ctx = makeStepContext(sampler, options, 1.0);
     ctx.quiet = &nowhere_quiet;
     ctx.flight_cap = 10.0;
     return ctx;
-  };
-  SimulationOptions merged;
-  merged.free_flight = true;
-  merged.volume_deposits = false;
-  merged.straight_step_voxels = 2.0;  // the command's defaults
-  SimulationOptions single = merged;
-  single.merge_straight_steps = false;
-  const StepContext merged_ctx = context(merged), single_ctx = context(single);
+  }
+};
+
+// One straight step at a time from `start` until a step `meets` (at most 20): the steps before it,
+// the patch after them and after the step that met.
+struct SteppedUntil {
+  int clear_steps = 0;
+  Patch before, after;
+};
+template <typename Meets>
+SteppedUntil stepUntil(const Patch& start, const VolumeSampler& sampler, const StepContext& ctx, Meets&& meets) {
+  SteppedUntil s;
+  s.before = start;
+  PatchSamples samples = samplePatch(start, sampler);
+  for (;; ++s.clear_steps) {
+    Patch next = s.before;
+    PatchSamples next_samples = samples;
+    const PatchStepResult r = stepPatch(next, next_samples, ctx);
+    EXPECT_FALSE(r.flight);
+    if (meets(r, next) || s.clear_steps >= 20) {
+      s.after = next;
+      return s;
+    }
+    s.before = next;
+    samples = next_samples;
+  }
+}
+
+TEST(CpuSimulator, StraightStepsMergeUpToTheOneThatMeetsAnInterface) {
+  // A glass slab, top face at y = −0.15; the patch starts 0.6 above it (14 voxels: 7 straight steps).
+  const Volume v = sharpVolume("procedural:box,size=0.8:0.3:0.8,center=0:-0.3:0,ior=1.5", 24, cube(0.5));
+  const VolumeSampler sampler(v);
+  const MergeContexts contexts(sampler);
+  const StepContext &merged_ctx = contexts.merged_ctx, &single_ctx = contexts.single_ctx;
   auto above = [&] {
     Patch patch = squarePatchGoingDown(sampler, 0.01);
     for (glm::dvec3& x : patch.x) x.y += 0.45;
@@ -871,20 +911,13 @@ TEST(CpuSimulator, StraightStepsMergeUpToTheOneThatMeetsAnInterface) {
     return patch;
   };
   // One straight step at a time, until one meets the slab.
-  Patch stepped = above();
-  ASSERT_EQ(stepped.medium[0], -1);
-  PatchSamples stepped_samples = samplePatch(stepped, sampler);
-  int clear_steps = 0;
-  for (;; ++clear_steps) {
-    Patch next = stepped;
-    PatchSamples next_samples = stepped_samples;
-    const PatchStepResult r = stepPatch(next, next_samples, single_ctx);
-    ASSERT_FALSE(r.flight);
-    if (next.medium[0] != -1 || r.fate != PatchFate::Keep) break;
-    stepped = next;
-    stepped_samples = next_samples;
-    ASSERT_LT(clear_steps, 20);
-  }
+  ASSERT_EQ(above().medium[0], -1);
+  const SteppedUntil single_steps = stepUntil(above(), sampler, single_ctx, [](const PatchStepResult& r, const Patch& p) {
+    return p.medium[0] != -1 || r.fate != PatchFate::Keep;
+  });
+  const Patch& stepped = single_steps.before;
+  const int clear_steps = single_steps.clear_steps;
+  ASSERT_LT(clear_steps, 20);
   ASSERT_GE(clear_steps, 5);  // 0.6 / (2 voxels) = 7.2 steps of air above the face
   // Merged: one patch-step to the same place (the sum of k steps against one of k times the time:
   // rounding alone), then the crossing.
@@ -918,20 +951,8 @@ TEST(CpuSimulator, AReflectedWavefrontsMergedStepsStopAtAWallThinnerThanAStep) {
                                    std::to_string(top - 0.5 * thickness) + ":0,ior=1.5",
                                48, cube(0.5));
   const VolumeSampler sampler(v);
-  const QuietMap nowhere_quiet;
-  auto context = [&](const SimulationOptions& options) {
-    StepContext ctx = makeStepContext(sampler, options, 1.0);
-    ctx.quiet = &nowhere_quiet;
-    ctx.flight_cap = 10.0;
-    return ctx;
-  };
-  SimulationOptions merged;
-  merged.free_flight = true;
-  merged.volume_deposits = false;
-  merged.straight_step_voxels = 2.0;  // the command's defaults
-  SimulationOptions single = merged;
-  single.merge_straight_steps = false;
-  const StepContext merged_ctx = context(merged), single_ctx = context(single);
+  const MergeContexts contexts(sampler);
+  const StepContext &merged_ctx = contexts.merged_ctx, &single_ctx = contexts.single_ctx;
   const double step = merged_ctx.reflected_step_dt;  // its length in air
   ASSERT_GT(step, 3.0 * thickness);
   // Three steps of air above the slab, the fourth from 0.06 above its top to below its bottom.
@@ -945,25 +966,14 @@ TEST(CpuSimulator, AReflectedWavefrontsMergedStepsStopAtAWallThinnerThanAStep) {
   ASSERT_LT(top + 0.06 - step, top - thickness);
   auto meets = [](const PatchStepResult& r, const Patch& p) { return r.reflected.x > 0.0 || p.medium[0] != -1; };
   // One straight step at a time: the fourth meets the slab, and leaves it on the far side.
-  Patch stepped = above();
-  ASSERT_EQ(stepped.medium[0], -1);
-  PatchSamples stepped_samples = samplePatch(stepped, sampler);
-  int clear_steps = 0;
-  for (;; ++clear_steps) {
-    Patch next = stepped;
-    PatchSamples next_samples = stepped_samples;
-    const PatchStepResult r = stepPatch(next, next_samples, single_ctx);
-    ASSERT_FALSE(r.flight);
-    if (meets(r, next)) {
-      // Both faces at normal incidence: (1 − R)² with R = (0.5 / 2.5)².
-      EXPECT_NEAR(next.flux.x / stepped.flux.x, (1.0 - 0.04) * (1.0 - 0.04), 1e-9);
-      for (int c = 0; c < 4; ++c) EXPECT_EQ(next.medium[c], -1) << c;
-      break;
-    }
-    stepped = next;
-    stepped_samples = next_samples;
-    ASSERT_LT(clear_steps, 10);
-  }
+  ASSERT_EQ(above().medium[0], -1);
+  const SteppedUntil single_steps = stepUntil(above(), sampler, single_ctx, meets);
+  const Patch& stepped = single_steps.before;
+  const int clear_steps = single_steps.clear_steps;
+  ASSERT_LT(clear_steps, 20);
+  // Both faces at normal incidence: (1 − R)² with R = (0.5 / 2.5)².
+  EXPECT_NEAR(single_steps.after.flux.x / stepped.flux.x, (1.0 - 0.04) * (1.0 - 0.04), 1e-9);
+  for (int c = 0; c < 4; ++c) EXPECT_EQ(single_steps.after.medium[c], -1) << c;
   EXPECT_EQ(clear_steps, 3);
   // Merged: one patch-step to where the three clear steps end, then the step that meets the slab.
   Patch patch = above();
