@@ -1658,7 +1658,7 @@ TEST(ExactOpticsLuneburg, GradedLensFocusesOnTheFarSurfaceWithinHalfAVoxel) {
 // chords meet the wall: willTear's look ahead of 4 patch sizes for the corners that have not met
 // it yet, and with straight steps a reflected wavefront's steps of 8 voxels and their merges.
 // With the look ahead asked at its end only, every patch that reached the wall tore, split to the
-// depth limit and died (1 % of the light killed, 28 times the patch-steps).
+// depth limit and died (1 % of the light killed; with steps of Δt 100 times the patch-steps).
 //  - Steps of Δt: what is not followed, hence in the ledger's `reflected`, is what the wall's top
 //    face sends back down of the wall's internal reflection (Φ·T·R·R) and what its two faces send
 //    back of the thick slab's reflection on its way up (Φ·T²·R·(1 − T²)), T = 1 − R at 35° (the
