@@ -184,6 +184,14 @@ const Field* iorGradient(const Volume& volume, const InterfaceTable& table, cons
   return &volume.require("ior_grad", 3, source);
 }
 
+const Field* refractiveIndex(const Volume& volume, const InterfaceTable& table, const std::string& source) {
+  if (const auto unread = volume.unread_fields.find("ior"); unread != volume.unread_fields.end()) {
+    if (unread->second != 1) throw InputError(source, "ior", std::to_string(unread->second) + " components, expected 1");
+    if (constantSlots(table)) return nullptr;
+  }
+  return &volume.require("ior", 1, source);
+}
+
 std::optional<float> unusedSlotDistance(const Field& interfaces, int used, double band) {
   if (used >= interfaces.components)
     return interfaces.components < kMaxInterfaceSlots ? std::optional<float>(static_cast<float>(band)) : std::nullopt;

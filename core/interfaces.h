@@ -20,7 +20,9 @@
 // (the discrete refraction of Ropinski et al. 2009, joined with the thesis' ray equation).
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
@@ -100,6 +102,23 @@ bool constantSlots(const InterfaceTable& table);
 // throughout (constantSlots) or left unread (Volume::unread_fields). An InputError naming `source`
 // where any other volume lacks it.
 const Field* iorGradient(const Volume& volume, const InterfaceTable& table, const std::string& source = "volume");
+
+// n of a volume: its ior field (1 component), or nullptr where it was left unread
+// (Volume::unread_fields) in a volume of constantSlots, whose n at a voxel centre is then that of
+// the first slot whose distance there is negative, 1 in none (what voxelize writes:
+// slotIndexAt). An InputError naming `source` where any other volume lacks it.
+const Field* refractiveIndex(const Volume& volume, const InterfaceTable& table, const std::string& source = "volume");
+
+// n at voxel `voxel` of a volume of constantSlots from its interfaces field (`distances`, one
+// distance a voxel per used slot, `components` of them): the first slot whose distance is negative
+// gives its n (as a float, as the ior field holds it), none gives 1.
+inline float slotIndexAt(const InterfaceTable& table, const float* distances, int components, std::size_t voxel) {
+  const float* d = distances + voxel * static_cast<std::size_t>(components);
+  const int slots = std::min(components, static_cast<int>(table.slots.size()));
+  for (int k = 0; k < slots; ++k)
+    if (d[k] < 0.0f) return static_cast<float>(table.slots[static_cast<std::size_t>(k)].ior);
+  return 1.0f;
+}
 
 // Which material a point is in: the slot index, or −1 for air.
 inline int materialSlot(const glm::dvec4& distances, int slot_count) {

@@ -27,20 +27,24 @@ void warnMapLeftOut(const std::string& source, const std::string& map) {
                source.c_str(), map.c_str());
 }
 
-// The viewer needs n and ∇n (Eq. 5.11/5.12) — ∇n may have been left unread (SceneLoadOptions) or
-// left out as 0 throughout (core/interfaces.h iorGradient); every other field is optional.
+// The viewer needs n and ∇n (Eq. 5.11/5.12) — in a volume of sharp constant-n materials either may
+// have been left unread (SceneLoadOptions) and ∇n left out as 0 throughout (core/interfaces.h
+// refractiveIndex, iorGradient); every other field is optional.
 void requireOptics(const Volume& volume, const std::string& source) {
-  volume.require("ior", 1, source);
-  iorGradient(volume, interfaceTable(volume, source), source);
+  const InterfaceTable table = interfaceTable(volume, source);
+  refractiveIndex(volume, table, source);
+  iorGradient(volume, table, source);
 }
 
-// How to read a volume: with SceneLoadOptions::leave_constant_gradient_unread, a volume of sharp
-// constant-n materials (its manifest's interface table says so) without ∇n.
+// How to read a volume: with SceneLoadOptions::leave_constant_optics_unread, a volume of sharp
+// constant-n materials (its manifest's interface table says so) without n and ∇n.
 Volume readOptics(const std::filesystem::path& path, const SceneLoadOptions& options) {
   VolumeReadOptions read;
-  if (options.leave_constant_gradient_unread) {
+  if (options.leave_constant_optics_unread) {
     const Volume header = readVolumeHeader(path);
-    if (constantSlots(interfaceTable(header, path.string())) && header.has("ior_grad")) read.leave_unread = {"ior_grad"};
+    if (constantSlots(interfaceTable(header, path.string())))
+      for (const char* field : {"ior", "ior_grad"})
+        if (header.has(field)) read.leave_unread.push_back(field);
   }
   return readVolume(path, read);
 }

@@ -40,10 +40,11 @@ SceneCameraSpec framingCamera(const GridSpec& grid, double fov_y_deg = 40.0);
 LoadedScene loadScene(const std::filesystem::path& input);
 
 struct SceneLoadOptions {
-  // A headless render's: ∇n of a volume whose sharp materials all have a constant n is not read
-  // (the shader takes each material's n and never samples it; at 132³ 28 MB). The window (its
-  // re-bake) and --bench (the bare march uploads it) read it.
-  bool leave_constant_gradient_unread = false;
+  // A headless render's: n and ∇n of a volume whose sharp materials all have a constant n are not
+  // read (the shader takes each material's n and never samples them, and the analyses take n from
+  // the interface distances, core/interfaces.h slotIndexAt; at 132³ 9 + 28 MB). The window (its
+  // re-bake) and --bench (the bare march uploads them) read them.
+  bool leave_constant_optics_unread = false;
 };
 LoadedScene loadScene(const std::filesystem::path& input, const SceneLoadOptions& options);
 

@@ -188,7 +188,7 @@ int run(int argc, char** argv) {
   std::optional<gl::DriverPreload> preload;
   if (!window_mode) preload.emplace(context_options);
   SceneLoadOptions load_options;
-  load_options.leave_constant_gradient_unread = !output.empty() && !bench;  // a headless render
+  load_options.leave_constant_optics_unread = !output.empty() && !bench;  // a headless render
   LoadedScene scene = loadScene(input, load_options);
   const bool is_scene = !scene.bare_volume;
   const ToneMapper tonemap =

@@ -49,6 +49,8 @@ struct RenderSettings {
   // Cross bricks of 4³ voxels where the medium is homogeneous (n, σa constant, nothing else) in one
   // step. Off by default: on llvmpipe the extra brick fetch a step cost more than it saved in the
   // scenes measured (64³ glass sphere 1.11× → 1.16× the bare march; 32³ absorbing one 2.2× → 2.8×).
+  // The bricks are found when an object's textures are made (the SceneRenderer's constructor,
+  // replaceVolume), only if this is on then; turned on later by setSettings, nothing is skipped.
   bool homogeneous_bricks = false;
   // A ray enters a boundary layer where |∇n|·h exceeds this (h: the voxel size) and leaves it where
   // |∇n|·h falls below a 16th of it; Fresnel is evaluated with n before and after the layer.

@@ -190,8 +190,8 @@ struct SceneRenderer::Impl {
 
   // One object's textures, bounds and shader defines, from its volume (the constructor, replaceVolume).
   Object makeObject(const LoadedObject& loaded, const std::vector<std::uint16_t>* prepared_texels = nullptr) const {
-    loaded.volume.require("ior", 1, loaded.source);
     const InterfaceTable table = interfaceTable(loaded.volume, loaded.source);
+    refractiveIndex(loaded.volume, table, loaded.source);
     iorGradient(loaded.volume, table, loaded.source);
     Object o;
     o.source = loaded.source;
@@ -241,7 +241,14 @@ struct SceneRenderer::Impl {
       throw RuntimeError("viewer: expected ior and ior_grad together in one RGBA texture");
     if (scene.ground) attachReceiver(o, loaded, *scene.ground, prepared_texels, scene.objects.size() > 1);
     if (o.has_receiver) o.defines += "#define HAS_RECEIVER 1\n";
-    const std::vector<float> bricks = homogeneousBricks(loaded.volume, o.brick_dims);
+    // The homogeneous bricks only where the march skips them (SKIP_HOMOGENEOUS, `--bricks`): at 132³
+    // their analysis reads every voxel's n and σa through 15 MB of fresh arrays. Otherwise one brick
+    // that is not homogeneous, which a program built with them later (setSettings) reads as no skip.
+    std::vector<float> bricks(1, 0.0f);
+    if (settings.homogeneous_bricks)
+      bricks = homogeneousBricks(loaded.volume, o.brick_dims);
+    else
+      o.brick_dims = glm::ivec3(1);
     o.bricks = gl::Texture3D(o.brick_dims, gl::TextureFormat::R32F, bricks, 1, gl::Sampling{gl::Filter::Nearest});
     return o;
   }

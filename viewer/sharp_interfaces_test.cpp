@@ -147,22 +147,71 @@ TEST_F(SharpViewerTest, AVolumeOfConstantNUploadsItsUsedDistancesAlone) {
   }
 }
 
-// A headless render leaves ∇n unread in a volume of sharp constant-n materials (SceneLoadOptions):
-// the picture is the one of the volume read whole, to the bit; a graded material's ∇n is read.
-TEST_F(SharpViewerTest, AHeadlessRenderLeavesAConstantNVolumesGradientUnread) {
+// A volume of sharp constant-n materials read without its ior field (SceneLoadOptions) gives the
+// viewer's analyses n from its interface distances: the n voxelize wrote at every voxel, and so the
+// same active region, box faces and homogeneous bricks as the field itself.
+TEST(SharpVolumeAnalysis, TakesNFromTheDistancesWhereTheIorFieldIsLeftUnread) {
+  // Two spheres of different n well inside the grid; a box of glass that reaches past its faces.
+  const Volume inside = sharpVolume(std::vector<std::string>{"procedural:sphere,r=0.3,center=0.1:0:0,ior=1.5",
+                                     "procedural:sphere,r=0.15,center=-0.3:0.1:0,ior=1.3"},
+                                    32, test_scenes::cube(0.6));
+  const Volume touching = sharpVolume(std::vector<std::string>{"procedural:box,size=1.4,ior=1.3", "procedural:sphere,r=0.3,ior=1.7"}, 32, test_scenes::cube(0.5));
+  for (const Volume* whole : {&inside, &touching}) {
+    const InterfaceTable table = interfaceTable(*whole);
+    ASSERT_TRUE(constantSlots(table));
+    ASSERT_EQ(table.slots.size(), 2u);
+    const Field& n = whole->fields.at("ior");
+    const Field& d = whole->fields.at("interfaces");
+    std::size_t differ = 0, glass = 0;
+    for (std::size_t i = 0; i < n.data.size(); ++i) {
+      differ += slotIndexAt(table, d.data.data(), d.components, i) != n.data[i] ? 1 : 0;
+      glass += n.data[i] != 1.0f ? 1 : 0;
+    }
+    EXPECT_EQ(differ, 0u);
+    EXPECT_GT(glass, 1000u);
+    Volume lean = *whole;
+    lean.fields.erase("ior");
+    lean.unread_fields["ior"] = 1;
+    EXPECT_EQ(refractiveIndex(lean, table), nullptr);
+    EXPECT_EQ(refractiveIndex(*whole, table), &n);
+    glm::dvec3 lo_whole, hi_whole, lo_lean, hi_lean;
+    ASSERT_TRUE(activeRegion(*whole, lo_whole, hi_whole));
+    ASSERT_TRUE(activeRegion(lean, lo_lean, hi_lean));
+    EXPECT_EQ(lo_lean, lo_whole);
+    EXPECT_EQ(hi_lean, hi_whole);
+    EXPECT_EQ(materialTouchesBox(lean), materialTouchesBox(*whole));
+    glm::ivec3 dims_whole, dims_lean;
+    const std::vector<float> bricks = homogeneousBricks(*whole, dims_whole);
+    EXPECT_EQ(homogeneousBricks(lean, dims_lean), bricks);
+    EXPECT_NE(std::count(bricks.begin(), bricks.end(), 1.0f), 0);  // glass and air inside, surfaces between
+    EXPECT_NE(std::count(bricks.begin(), bricks.end(), 0.0f), 0);
+  }
+  glm::dvec3 lo, hi;
+  ASSERT_TRUE(activeRegion(inside, lo, hi));
+  EXPECT_GT(lo.x, inside.grid.bounds_min.x + 0.1);  // a box within the grid, not the grid
+  EXPECT_FALSE(materialTouchesBox(inside));
+  EXPECT_TRUE(materialTouchesBox(touching));
+}
+
+// A headless render leaves n and ∇n unread in a volume of sharp constant-n materials
+// (SceneLoadOptions): the picture is the one of the volume read whole, to the bit (the analyses take
+// n from the interface distances); a graded material's n and ∇n are read.
+TEST_F(SharpViewerTest, AHeadlessRenderLeavesAConstantNVolumesOpticsUnread) {
   test_support::TempDir dir;
   // With its ∇n (0 throughout), as volumes were written before voxelize left it out.
   Volume ball = sharpVolume("procedural:sphere,r=0.5,ior=1.5", 40, box({-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6}));
   ball.addField("ior_grad", 3);
   writeVolume(ball, dir / "ball.vol.json");
   SceneLoadOptions lean_options;
-  lean_options.leave_constant_gradient_unread = true;
+  lean_options.leave_constant_optics_unread = true;
   LoadedScene whole = loadScene(dir / "ball.vol.json"), lean = loadScene(dir / "ball.vol.json", lean_options);
   ASSERT_EQ(lean.objects.size(), 1u);
   EXPECT_FALSE(lean.objects[0].volume.has("ior_grad"));
   EXPECT_TRUE(lean.objects[0].volume.unread_fields.count("ior_grad"));
-  EXPECT_TRUE(lean.objects[0].volume.has("ior"));  // the analyses' (region, bricks, faces)
+  EXPECT_FALSE(lean.objects[0].volume.has("ior"));
+  EXPECT_TRUE(lean.objects[0].volume.unread_fields.count("ior"));
   EXPECT_TRUE(whole.objects[0].volume.has("ior_grad"));
+  EXPECT_TRUE(whole.objects[0].volume.has("ior"));
   const Camera camera = lookAlong({0.3, 0.4, 2.0}, glm::normalize(glm::dvec3(-0.3, -0.4, -2.0)), 30.0);
   for (LoadedScene* s : {&whole, &lean}) {
     s->scene.lights.clear();
@@ -182,6 +231,7 @@ TEST_F(SharpViewerTest, AHeadlessRenderLeavesAConstantNVolumesGradientUnread) {
   graded.addField("ior_grad", 3);
   writeVolume(graded, dir / "graded.vol.json");
   EXPECT_TRUE(loadScene(dir / "graded.vol.json", lean_options).objects[0].volume.has("ior_grad"));
+  EXPECT_TRUE(loadScene(dir / "graded.vol.json", lean_options).objects[0].volume.has("ior"));
   // As voxelize writes it now: no ∇n to leave unread, the same picture.
   writeVolume(sharpVolume("procedural:sphere,r=0.5,ior=1.5", 40, box({-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6})),
               dir / "lean.vol.json");

@@ -8,17 +8,41 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/error.h"
 #include "core/parallel.h"
 
 namespace eik {
 
 namespace {
 
+// n at each voxel: the ior field's, or where it was left unread in a volume of sharp constant-n
+// materials (SceneLoadOptions::leave_constant_optics_unread) the n its interface distances give,
+// which is what voxelize wrote (core/interfaces.h slotIndexAt); 1 in a volume without either.
+class IndexAt {
+ public:
+  explicit IndexAt(const Volume& v) : ior_(v.find("ior")) {
+    if (ior_ || !v.unread_fields.count("ior")) return;
+    table_ = interfaceTable(v);
+    if (constantSlots(table_)) distances_ = v.find("interfaces");
+  }
+  bool known() const { return ior_ || distances_; }
+  float operator()(std::size_t i) const {
+    if (ior_) return ior_->data[i];
+    return distances_ ? slotIndexAt(table_, distances_->data.data(), distances_->components, i) : 1.0f;
+  }
+
+ private:
+  const Field* ior_;
+  InterfaceTable table_;
+  const Field* distances_ = nullptr;
+};
+
 // The fields the analyses read (null where the volume has none).
 struct MediumFields {
-  const Field *ior, *grad, *sigma, *emission, *scatter, *opaque;
+  IndexAt n;  // the ior field or what stands for it
+  const Field *grad, *sigma, *emission, *scatter, *opaque;
   explicit MediumFields(const Volume& v)
-      : ior(v.find("ior")), grad(v.find("ior_grad")), sigma(v.find("sigma_a")), emission(v.find("emission")),
+      : n(v), grad(v.find("ior_grad")), sigma(v.find("sigma_a")), emission(v.find("emission")),
         scatter(v.find("scatter")), opaque(v.find("opaque")) {}
 };
 
@@ -29,11 +53,10 @@ bool activeRegion(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi) {
   const glm::ivec3 dims = grid.dims;
   const double h = std::min({grid.voxelSize().x, grid.voxelSize().y, grid.voxelSize().z});
   const MediumFields f(volume);
-  const Field *ior = f.ior, *grad = f.grad, *sigma = f.sigma, *emission = f.emission, *scatter = f.scatter,
-              *opaque = f.opaque;
+  const Field *grad = f.grad, *sigma = f.sigma, *emission = f.emission, *scatter = f.scatter, *opaque = f.opaque;
   auto nontrivial = [&](std::size_t i) {
     auto positive3 = [&](const Field* f) { return f && (f->voxel(i)[0] > 0 || f->voxel(i)[1] > 0 || f->voxel(i)[2] > 0); };
-    if (ior && std::abs(ior->voxel(i)[0] - 1.0f) > 1e-5f) return true;
+    if (std::abs(f.n(i) - 1.0f) > 1e-5f) return true;
     if (grad) {
       const float* v = grad->voxel(i);
       if ((std::abs(v[0]) + std::abs(v[1]) + std::abs(v[2])) * h > 1e-6) return true;
@@ -150,8 +173,8 @@ std::vector<float> homogeneousBricks(const Volume& volume, glm::ivec3& brick_dim
   brick_dims = (dims + kBrickVoxels - 1) / kBrickVoxels;
   const double h = std::min({grid.voxelSize().x, grid.voxelSize().y, grid.voxelSize().z});
   const MediumFields f(volume);
-  const Field *ior = f.ior, *grad = f.grad, *sigma = f.sigma, *emission = f.emission, *scatter = f.scatter,
-              *opaque = f.opaque;
+  const Field *grad = f.grad, *sigma = f.sigma, *emission = f.emission, *scatter = f.scatter, *opaque = f.opaque;
+  if (!f.n.known()) throw InputError("volume", "ior", "the homogeneous bricks need n");
   // A brick is homogeneous when no voxel of its box (the brick and its margin) is busy — breaks
   // homogeneity by itself with ∇n, emission, scattering or an opaque embedding — and n and each σa
   // differ from those of the box's first voxel by no more than the tolerances. The box is a product
@@ -172,7 +195,7 @@ std::vector<float> homogeneousBricks(const Volume& volume, glm::ivec3& brick_dim
       for (int x = 0; x < dims.x; ++x) {
         const std::size_t i = row + static_cast<std::size_t>(x);
         float* v = &values[static_cast<std::size_t>(x) * channels];
-        v[0] = ior->data[i];
+        v[0] = f.n(i);
         if (sigma) std::copy_n(sigma->voxel(i), 3, v + 1);
         if (!any_busy) continue;
         const float* g = grad ? grad->voxel(i) : nullptr;
@@ -207,7 +230,7 @@ std::vector<float> homogeneousBricks(const Volume& volume, glm::ivec3& brick_dim
         bool homogeneous = boxes.busy[e] == 0;
         const float* vlo = &boxes.lo[e * channels];
         const float* vhi = &boxes.hi[e * channels];
-        const float n0 = ior->data[first];
+        const float n0 = f.n(first);
         if (std::abs(vhi[0] - n0) > 1e-4f || std::abs(vlo[0] - n0) > 1e-4f) homogeneous = false;
         for (int c = 1; c < channels; ++c) {
           const float s0 = sigma->voxel(first)[c - 1];
@@ -220,9 +243,10 @@ std::vector<float> homogeneousBricks(const Volume& volume, glm::ivec3& brick_dim
 
 bool materialTouchesBox(const Volume& volume) {
   const GridSpec& grid = volume.grid;
-  const Field* ior = volume.find("ior");
+  const IndexAt n(volume);
+  if (!n.known()) throw InputError("volume", "ior", "whether the material touches the box needs n");
   const glm::ivec3 last = grid.dims - 1;
-  auto material = [&](int i, int j, int k) { return std::abs(ior->data[grid.index(i, j, k)] - 1.0f) > 1e-3f; };
+  auto material = [&](int i, int j, int k) { return std::abs(n(grid.index(i, j, k)) - 1.0f) > 1e-3f; };
   // The two faces across z, then across y, then across x (only the voxels on the box's faces).
   for (int k : {0, last.z})
     for (int j = 0; j <= last.y; ++j)
