@@ -153,9 +153,11 @@ TEST_F(SharpViewerTest, AVolumeOfConstantNUploadsItsUsedDistancesAlone) {
 TEST(SharpVolumeAnalysis, TakesNFromTheDistancesWhereTheIorFieldIsLeftUnread) {
   // Two spheres of different n well inside the grid; a box of glass that reaches past its faces.
   const Volume inside = sharpVolume(std::vector<std::string>{"procedural:sphere,r=0.3,center=0.1:0:0,ior=1.5",
-                                     "procedural:sphere,r=0.15,center=-0.3:0.1:0,ior=1.3"},
+                                                             "procedural:sphere,r=0.15,center=-0.3:0.1:0,ior=1.3"},
                                     32, test_scenes::cube(0.6));
-  const Volume touching = sharpVolume(std::vector<std::string>{"procedural:box,size=1.4,ior=1.3", "procedural:sphere,r=0.3,ior=1.7"}, 32, test_scenes::cube(0.5));
+  const Volume touching = sharpVolume(
+      std::vector<std::string>{"procedural:box,size=1.4,ior=1.3", "procedural:sphere,r=0.3,ior=1.7"}, 32,
+      test_scenes::cube(0.5));
   for (const Volume* whole : {&inside, &touching}) {
     const InterfaceTable table = interfaceTable(*whole);
     ASSERT_TRUE(constantSlots(table));
