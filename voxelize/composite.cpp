@@ -35,6 +35,10 @@ nlohmann::json rgb(const glm::vec3& v) { return nlohmann::json::array({tidy(v.x)
 
 }  // namespace
 
+bool blendsFields(const Material& m) {
+  return nonZero(m.sigma_a) || nonZero(m.emission) || m.scatter != 0.0f || m.opaque || m.dispersion_b != 0.0f;
+}
+
 std::vector<std::size_t> compositeOrder(const std::vector<Region>& regions) {
   std::vector<std::size_t> order(regions.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
@@ -61,7 +65,7 @@ Volume compositeRegions(const std::vector<Region>& regions, const GridSpec& grid
        need_opaque = options.all_fields, need_dispersion = options.all_fields;
   for (const auto& r : regions) {
     const Material& m = r.material;
-    need_sigma_a |= nonZero(m.sigma_a);
+    need_sigma_a |= nonZero(m.sigma_a);  // (blendsFields: any of these)
     need_emission |= nonZero(m.emission);
     need_scatter |= m.scatter != 0.0f;
     need_opaque |= m.opaque;

@@ -35,6 +35,12 @@ struct CompositeOptions {
 // whose arrays do not match the grid.
 Volume compositeRegions(const std::vector<Region>& regions, const GridSpec& grid, const CompositeOptions& options = {});
 
+// Whether a region of this material makes compositeRegions write a field besides `ior` (σa,
+// emission, scattering, opaque, dispersion), which blend the regions by their coverage. Without
+// one, and with sharp interfaces (whose n comes from the distances, sharp_interfaces.h), a region's
+// coverage decides nothing but its enclosed and reported volume.
+bool blendsFields(const Material& material);
+
 // The order in which compositeRegions hands out voxel space: indices into `regions`, innermost
 // (smallest enclosed_volume) first, ties broken in favour of the later input.
 std::vector<std::size_t> compositeOrder(const std::vector<Region>& regions);

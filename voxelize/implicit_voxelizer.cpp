@@ -40,6 +40,15 @@ void recordDistance(const ImplicitSolid& solid, const GridSpec& grid, double ban
         const std::size_t at = grid.index(i, j, k);
         region.distance[at] = static_cast<float>(std::clamp(d, -band, band));
         if (graded && d < band) region.ior_at_center[at] = static_cast<float>(std::max(1.0, solid.ior(c)));
+        // The next voxels along x whose distance the 1-Lipschitz bound clamps as this one's: at
+        // least |d| − m·h.x ≥ band away on the same side (outside: the default already there;
+        // inside: −band, unless a graded solid needs its n at each centre).
+        const double beyond = (std::fabs(d) - band) / h.x;
+        if (beyond >= 1.0 && (d > 0.0 || !graded)) {
+          const int run = std::min(static_cast<int>(beyond), hi.x - 1 - i);
+          if (d < 0.0) std::fill_n(&region.distance[at + 1], run, static_cast<float>(-band));
+          i += run;
+        }
       }
   });
 }

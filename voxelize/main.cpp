@@ -62,7 +62,7 @@ int run(int argc, char** argv) {
                  "material of OBJ and procedural inputs: KEY=VALUE[,KEY=VALUE...] with keys ior, "
                  "sigma_a=R:G:B, emission=R:G:B, albedo=R:G:B (opaque), scatter, g, abbe, name. Given once "
                  "it applies to all of them, given several times the i-th applies to the i-th such input");
-  app.add_option("--supersample", o.supersample, "sub-samples per voxel and axis for anti-aliased occupancy (default 4)")
+  app.add_option("--supersample", o.supersample, "sub-samples per voxel and axis for anti-aliased occupancy (default 4; a procedural shape with sharp interfaces and no absorbing, emitting, scattering, opaque or dispersive material takes one, at the voxel centre: only its reported volume reads the occupancy)")
       ->check(CLI::Range(1, 16));
   app.add_option("--surface", o.surface,
                  "how meshes are read: auto (open sheets become thin opaque receivers), solid, surface")

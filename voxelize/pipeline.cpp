@@ -15,6 +15,7 @@
 #include "core/scene.h"
 #include "core/stopwatch.h"
 #include "core/text.h"
+#include "voxelize/composite.h"
 #include "voxelize/material_spec.h"
 #include "voxelize/mesh_scene.h"
 #include "voxelize/mesh_voxelizer.h"
@@ -200,6 +201,19 @@ std::vector<Region> voxelizeObjects(const std::vector<Input>& inputs, const Grid
   const Stopwatch clock;
   std::vector<Region> regions;
   json objects_stats = json::array();
+  // With sharp interfaces and no material that blends a field by coverage (composite.h
+  // blendsFields), a procedural shape's coverage is read for its volume alone: n comes from the
+  // distances. It is then taken from the distance at each voxel centre (one sample a voxel,
+  // clamp(½ − d/h, 0, 1)) instead of S³ sub-samples: the same fields to the bit, the 128³ sphere's
+  // command 85 → 70 ms, its reported volume 3e-5 larger (VoxelizeFiles test
+  // ASharpClearShapeTakesItsOccupancyAtTheVoxelCentres).
+  bool coverage_blends = o.interfaces != "sharp";
+  for (const Input& in : inputs) {
+    if (in.mesh) coverage_blends |= blendsFields(in.mesh->material);
+    if (in.procedural)
+      for (const ImplicitSolid& solid : proceduralSolids(*in.procedural, grid)) coverage_blends |= blendsFields(solid.material);
+  }
+  stats["procedural_supersample"] = coverage_blends ? o.supersample : 1;
   {
     ProgressBar bar("voxelize", !o.quiet);
     const double share = 1.0 / static_cast<double>(inputs.size());
@@ -209,7 +223,7 @@ std::vector<Region> voxelizeObjects(const std::vector<Input>& inputs, const Grid
       const double band = o.interfaces == "sharp" ? interfaceBand(grid) : 0.0;
       if (in.procedural) {
         ProceduralOptions options;
-        options.supersample = o.supersample;
+        options.supersample = coverage_blends ? o.supersample : 1;
         options.distance_band = band;
         for (Region& r : voxelizeProcedural(*in.procedural, grid, options, progress)) {
           objects_stats.push_back({{"input", in.source}, {"region", r.name}, {"enclosed_volume", r.enclosed_volume}});
