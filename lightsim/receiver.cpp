@@ -104,7 +104,7 @@ double polygonArea(const glm::dvec2* p, int count) {
 // between its vertices' x (continuous and concave inside, as the polygon is convex), so its
 // integral H(x) is piecewise quadratic and a texel's overlap is H(x₁) − H(x₀): exact, and a few
 // operations a texel instead of a clip.
-void depositRow(const ReceiverMap& map, const glm::dvec2* p, int n, const glm::dvec3& density, glm::dvec3* row) {
+void depositRow(const ReceiverMap& map, const glm::dvec2* p, int n, const glm::dvec3& density, const TexelRows& out, int j) {
   // A convex polygon of at most 4 vertices clipped by two half-planes has at most 6.
   if (n < 3 || n > 8) return;
   double xs[8];
@@ -149,7 +149,7 @@ void depositRow(const ReceiverMap& map, const glm::dvec2* p, int n, const glm::d
   for (int i = i0; i <= i1; ++i) {
     const double right = integral(std::min(xmax, map.origin.x + (i + 1) * map.pitch));
     const double overlap = right - left;
-    if (overlap > 0.0) row[i] += density * overlap;
+    if (overlap > 0.0) out.add(j, i, density * overlap);
     left = right;
   }
 }
@@ -166,7 +166,7 @@ void depositConvex(const ReceiverMap& map, const glm::dvec2* polygon, int count,
     const glm::dvec2 t = (centre - map.origin) / map.pitch;
     const int i = static_cast<int>(std::floor(t.x)), j = static_cast<int>(std::floor(t.y));
     if (i >= 0 && j >= std::max(0, row_begin) && i < map.texels.x && j < std::min(map.texels.y, row_end))
-      out.row(j)[i] += flux;
+      out.add(j, i, flux);
     return;
   }
   double ylo = polygon[0].y, yhi = polygon[0].y;
@@ -183,7 +183,7 @@ void depositConvex(const ReceiverMap& map, const glm::dvec2* polygon, int count,
     int n = clipAgainst(buffer_a, count, buffer_b, 1, y0, -1.0);
     n = clipAgainst(buffer_b, n, buffer_a, 1, y1, 1.0);
     if (n < 3) continue;
-    depositRow(map, buffer_a, n, density, out.row(j));
+    depositRow(map, buffer_a, n, density, out, j);
   }
 }
 
@@ -263,6 +263,7 @@ FootprintSums::FootprintSums(const ReceiverMap& map) : map_(map) {
     level.texels = (map.texels + glm::ivec2((1 << k) - 1)) / (1 << k);
     coarse_.push_back(std::move(level));
   }
+  fine_.assign(3 * map_.texelCount(), 0.0f);
   bands_.assign(kFootprintLevels + 1, std::vector<std::vector<glm::dvec3>>(static_cast<std::size_t>(bands())));
 }
 
@@ -282,17 +283,20 @@ void FootprintSums::deposit(const std::array<glm::dvec2, 4>& footprint, const gl
   const int k = level(footprint);
   const int rows = kBandRows >> k;
   const ReceiverMap& level_map = k == 0 ? map_ : coarse_[static_cast<std::size_t>(k - 1)];
+  const int first = band * rows;
+  if (k == 0) {
+    depositFootprint(map_, footprint, flux, TexelRows{nullptr, map_.texels.x, 0, first, first + rows, fine_.data()});
+    return;
+  }
   std::vector<glm::dvec3>& block = bands_[static_cast<std::size_t>(k)][static_cast<std::size_t>(band)];
   if (block.empty()) block.assign(static_cast<std::size_t>(rows) * static_cast<std::size_t>(level_map.texels.x), glm::dvec3(0.0));
-  const int first = band * rows;
   depositFootprint(level_map, footprint, flux, TexelRows{block.data(), level_map.texels.x, first, first, first + rows});
 }
 
 FootprintSums::RowSums FootprintSums::rowSums(int j) const {
   const int band = j / kBandRows;
   RowSums r;
-  const std::vector<glm::dvec3>& fine = bands_[0][static_cast<std::size_t>(band)];
-  if (!fine.empty()) r.level[0] = fine.data() + static_cast<std::size_t>(j - band * kBandRows) * static_cast<std::size_t>(map_.texels.x);
+  r.fine = fine_.data() + 3 * static_cast<std::size_t>(j) * static_cast<std::size_t>(map_.texels.x);
   for (int k = 1; k <= kFootprintLevels; ++k) {
     // A band of the map is a whole band of every level (kBandRows is a multiple of 2^k).
     const std::vector<glm::dvec3>& block = bands_[static_cast<std::size_t>(k)][static_cast<std::size_t>(band)];
@@ -307,7 +311,8 @@ FootprintSums::RowSums FootprintSums::rowSums(int j) const {
 glm::dvec3 FootprintSums::RowSums::flux(int i) const {
   // The texel's own flux, then each coarser level's share over it, k = 1, 2, ... in order (the same
   // sums whatever the thread count).
-  glm::dvec3 f = level[0] ? level[0][i] : glm::dvec3(0.0);
+  const float* texel = fine + 3 * static_cast<std::size_t>(i);
+  glm::dvec3 f(texel[0], texel[1], texel[2]);
   for (int k = 1; k <= kFootprintLevels; ++k)
     if (level[k]) f += level[k][i >> k] * (1.0 / static_cast<double>(1 << (2 * k)));
   return f;
@@ -327,22 +332,22 @@ std::vector<glm::dvec3> FootprintSums::resolve() const {
   return out;
 }
 
-void FootprintSums::irradiance(const DirectMapLight* extra, double inv_area, std::vector<float>& out) const {
-  out.resize(map_.texelCount() * 3);
+void FootprintSums::irradiance(const DirectMapLight* extra, double inv_area, std::vector<float>& out) {
   parallelFor(
       0, map_.texels.y,
       [&](std::int64_t j64) {
         const int j = static_cast<int>(j64);
         const RowSums sums = rowSums(j);
-        const std::size_t first = static_cast<std::size_t>(j) * static_cast<std::size_t>(map_.texels.x);
-        float* row = out.data() + 3 * first;
+        float* row = fine_.data() + 3 * static_cast<std::size_t>(j) * static_cast<std::size_t>(map_.texels.x);
         for (int i = 0; i < map_.texels.x; ++i) {
-          glm::dvec3 flux = sums.flux(i);
+          glm::dvec3 flux = sums.flux(i);  // (texel i's sums read before they are written over)
           if (extra) flux += extra->flux(i, j);
           for (int c = 0; c < 3; ++c) row[3 * i + c] = static_cast<float>(flux[c] * inv_area);
         }
       },
       16);
+  out = std::move(fine_);
+  fine_.clear();
 }
 
 double triangleSquareOverlap(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c, const glm::dvec2& lo,
@@ -387,7 +392,7 @@ void depositFootprint(const ReceiverMap& map, const std::array<glm::dvec2, 4>& f
         for (int i = i0; i <= i1; ++i) {
           const double x0 = map.origin.x + i * map.pitch;
           const double ox = std::min(hi.x, x0 + map.pitch) - std::max(lo.x, x0);
-          if (ox > 0.0) out.row(j)[i] += density * (ox * oy);
+          if (ox > 0.0) out.add(j, i, density * (ox * oy));
         }
       }
       return;
