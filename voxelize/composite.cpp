@@ -74,7 +74,7 @@ Volume compositeRegions(const std::vector<Region>& regions, const GridSpec& grid
 
   Volume volume;
   volume.grid = grid;
-  Field& ior = addZeroField(volume, "ior", 1, count);
+  Field* ior = options.ior ? &addZeroField(volume, "ior", 1, count) : nullptr;
   Field* sigma_a = need_sigma_a ? &addZeroField(volume, "sigma_a", 3, count) : nullptr;
   Field* emission = need_emission ? &addZeroField(volume, "emission", 3, count) : nullptr;
   Field* scatter = need_scatter ? &addZeroField(volume, "scatter", 2, count) : nullptr;
@@ -115,7 +115,7 @@ Volume compositeRegions(const std::vector<Region>& regions, const GridSpec& grid
           albedo += f * m.albedo;
         }
       }
-      ior.data[v] = n;
+      if (ior) ior->data[v] = n;
       if (sigma_a) std::copy(&sa.x, &sa.x + 3, sigma_a->voxel(v));
       if (emission) std::copy(&le.x, &le.x + 3, emission->voxel(v));
       if (scatter) {

@@ -24,11 +24,15 @@ struct CompositeOptions {
   // Write sigma_a, emission, scatter, opaque and dispersion even when no region needs them
   // (by default only fields some region makes non-zero are written).
   bool all_fields = false;
+  // Blend `ior` by coverage (smooth interfaces). False: the field is left out, for a caller that
+  // takes n from somewhere else (sharp interfaces: n at the voxel centres from the distances,
+  // sharp_interfaces.h), which then neither computes nor touches that grid of floats.
+  bool ior = true;
   ProgressFn progress;
 };
 
 // Composites `regions` (each coverage (and ior, if any) grid.count() long) into a Volume on `grid`
-// with field `ior` and, as needed, `sigma_a`, `emission`, `scatter`, `opaque`, `dispersion`.
+// with field `ior` (unless CompositeOptions::ior is false) and, as needed, `sigma_a`, `emission`, `scatter`, `opaque`, `dispersion`.
 // volume.metadata["materials"] gets one entry per region, in input order: name, ior, sigma_a,
 // emission, scatter, g, dispersion_b, opaque (+ albedo), enclosed_volume and `volume`, the world
 // volume it holds after compositing (Σ f_i·V_voxel). Throws std::invalid_argument for a region

@@ -57,6 +57,26 @@ TEST(Composite, InnermostWinsAndAirTakesTheRest) {
   EXPECT_NEAR(m[1].at("ior").get<double>(), 1.8, 1e-6);
 }
 
+TEST(Composite, LeavesIorOutWhenTheCallerMakesIt) {
+  // Sharp interfaces take n from the distances (sharp_interfaces.cpp): the composite then makes no
+  // `ior`, and everything else as with it: the blended fields and each region's volume.
+  Material inner;
+  inner.ior = 1.8f;
+  inner.sigma_a = glm::vec3(4, 0, 0);
+  Material outer;
+  outer.ior = 1.4f;
+  const std::vector<Region> regions = {region("outer", 0.7f, 10.0, outer), region("inner", 0.6f, 1.0, inner)};
+  CompositeOptions without;
+  without.ior = false;
+  const Volume with_ior = compositeRegions(regions, oneVoxel());
+  const Volume v = compositeRegions(regions, oneVoxel(), without);
+  EXPECT_FALSE(v.has("ior"));
+  ASSERT_TRUE(v.has("sigma_a"));
+  EXPECT_EQ(v.fields.at("sigma_a").data, with_ior.fields.at("sigma_a").data);
+  EXPECT_EQ(v.metadata.at("materials"), with_ior.metadata.at("materials"));
+  EXPECT_NEAR(v.metadata.at("materials")[0].at("volume").get<double>(), 0.4 / 8.0, 1e-7);
+}
+
 TEST(Composite, PartialCoverageMixesWithAir) {
   Material glass;
   glass.ior = 1.5f;

@@ -137,7 +137,11 @@ Volume buildSharp(const std::vector<Region>& regions, std::vector<Region>* relea
   const SlotAssignment slots = assignInterfaceSlots(regions, band);
   const int slot_count = static_cast<int>(slots.table.slots.size());
 
-  Volume volume = compositeRegions(regions, grid, options);
+  // n is not blended by coverage here: it comes from the distances below, every voxel's. The
+  // composite makes the fields that are (σa, emission, …) and the materials' volumes.
+  CompositeOptions blended = options;
+  blended.ior = false;
+  Volume volume = compositeRegions(regions, grid, blended);
   release(&Region::coverage);  // read by compositing only (a region's `ior` says it is graded: kept)
 
   // Slot distances: the union (min) of their regions, one per slot (docs/volume-format.md).
@@ -157,8 +161,9 @@ Volume buildSharp(const std::vector<Region>& regions, std::vector<Region>* relea
   }
   release(&Region::distance);
 
-  // n, B and the material label at the voxel centres.
-  Field& ior = volume.fields.at("ior");
+  // n, B and the material label at the voxel centres (`ior` made once the distances are released,
+  // whose memory it then takes: the 128³ sphere touches two grids of floats here, not four).
+  Field& ior = volume.addField("ior", 1);
   const bool any_dispersion = std::any_of(slots.table.slots.begin(), slots.table.slots.end(),
                                           [](const InterfaceSlot& s) { return s.dispersion_b != 0.0; });
   Field* dispersion = nullptr;
