@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "core/parallel.h"
+#include "core/uninitialized.h"
 #include "lightsim/interface_crossing.h"
 #include "lightsim/receiver.h"
 #include "lightsim/track_deposit.h"
@@ -677,14 +678,14 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   }
   double flux_ref = 0.0;
   DirectCells direct;  // cells that go straight to the receiver's map: in closed form, not followed
-  std::vector<Patch> patches = initialPatches(light, grid, sampler_, options, &flux_ref, ctx.receiver, &direct);
+  std::vector<Patch> initial = initialPatches(light, grid, sampler_, options, &flux_ref, ctx.receiver, &direct);
   std::optional<DirectMapLight> direct_light;
-  if (direct.cells > 0) direct_light = directMapLight(receiver, light, patches);
-  adjustInitialPatches(patches, sampler_, options, flux_ref);
+  if (direct.cells > 0) direct_light = directMapLight(receiver, light, initial);
+  adjustInitialPatches(initial, sampler_, options, flux_ref);
   ctx.flux_ref = flux_ref;
   ctx.dim_irradiance = kDimTrackFraction * brightestIrradiance(light, grid);
-  stats.initial_patches = patches.size();
-  for (const Patch& p : patches) stats.flux_in += p.flux;
+  stats.initial_patches = initial.size();
+  for (const Patch& p : initial) stats.flux_in += p.flux;
   stats.phase_seconds["init"] = phase.seconds();
 
   const int max_steps = maxSteps(grid, options);
@@ -694,29 +695,44 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
 
   // Deposit targets, in double (accumulate) or the strongest patch so far (max); none without
   // volume deposits.
-  std::vector<DepositSum> sums(patches.empty() || !volume_deposits ? 0 : voxels);
+  // Zeroed by both threads (a voxel's sums are a cache line: 147 MB at 132³, which one thread's
+  // value-initialisation faulted in alone).
+  UninitializedVector<DepositSum> sums;
+  if (!initial.empty() && volume_deposits) {
+    sums.resize(voxels);
+    parallelFor(0, static_cast<std::int64_t>(voxels), [&](std::int64_t v) { sums[static_cast<std::size_t>(v)] = DepositSum{}; }, 1 << 14);
+  }
   std::vector<double> best_key(accumulate || sums.empty() ? 0 : voxels, -1.0);
 
-  std::vector<PatchSamples> samples(patches.size());
+  // The patch lists and their samples: grown without writing the added elements (core/uninitialized.h),
+  // which the parallel loops below then write in full, each thread faulting in its own share of
+  // the fresh pages (a std::vector's `resize` wrote them all on this thread first).
+  // Room for many times the initial patches in each per-patch array: address space costs nothing
+  // until a page is touched, and the arrays then neither move nor touch fresh memory (which the
+  // kernel zeroes, 2 MiB at a time) each time the wavefront outgrows them.
+  const std::size_t capacity = std::max<std::size_t>(8 * initial.size(), std::size_t(1) << 16);
+  UninitializedVector<Patch> patches, next;
+  UninitializedVector<PatchSamples> samples, next_samples;
+  patches.reserve(capacity);
+  samples.reserve(capacity);
+  next.reserve(capacity);
+  next_samples.reserve(capacity);
+  patches.resize(initial.size());
+  samples.resize(initial.size());
   parallelFor(
-      0, static_cast<std::int64_t>(patches.size()),
-      [&](std::int64_t i) { samples[static_cast<std::size_t>(i)] = samplePatch(patches[static_cast<std::size_t>(i)], sampler_); },
+      0, static_cast<std::int64_t>(initial.size()),
+      [&](std::int64_t i64) {
+        const std::size_t i = static_cast<std::size_t>(i64);
+        patches[i] = initial[i];
+        samples[i] = samplePatch(initial[i], sampler_);
+      },
       256);
+  std::vector<Patch>().swap(initial);
   std::vector<PatchStepResult> results;
   std::vector<std::vector<std::uint32_t>> slab_lists;
   std::vector<std::uint64_t> offsets;
   std::vector<std::uint32_t> received;  // this step's received patches
   std::vector<std::vector<std::uint32_t>> band_lists;  // …and those whose footprint reaches each band of map rows
-  std::vector<Patch> next;
-  std::vector<PatchSamples> next_samples;
-  // Room for many times the initial patches in each per-patch array: address space costs nothing
-  // until a page is touched, and the arrays then neither move nor touch fresh memory (which the
-  // kernel zeroes, 2 MiB at a time) each time the wavefront outgrows them.
-  const std::size_t capacity = std::max<std::size_t>(8 * patches.size(), std::size_t(1) << 16);
-  patches.reserve(capacity);
-  samples.reserve(capacity);
-  next.reserve(capacity);
-  next_samples.reserve(capacity);
   results.reserve(capacity);
   offsets.reserve(capacity + 1);
   double t_update = 0.0, t_deposit = 0.0, t_compact = 0.0;

@@ -88,7 +88,7 @@ HWY_INLINE void nodeCoefficients(const double* HWY_RESTRICT k4, const double* HW
 }
 
 // The sub-paths of the patch-steps in `list` (patch order), within slab `slab`'s voxels.
-void depositSlab(const std::vector<Patch>& patches, const std::vector<PatchStepResult>& results,
+void depositSlab(std::span<const Patch> patches, std::span<const PatchStepResult> results,
                  const GridSpec& grid, const ReceiverMap* receiver, DepositSum* sums,
                  const std::vector<std::uint32_t>& list, int slab, int slab_depth) {
   const double inv_volume = 1.0 / grid.voxelVolume();
@@ -330,8 +330,8 @@ void setTrackDepositTarget(const std::string& name) {
   throw InputError("SIMD target \"" + name + "\": not one this build runs here (" + known + ")");
 }
 
-void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<PatchStepResult>& results,
-                        const GridSpec& grid, const ReceiverMap* receiver, std::vector<DepositSum>& sums,
+void applyTrackDeposits(std::span<const Patch> patches, std::span<const PatchStepResult> results,
+                        const GridSpec& grid, const ReceiverMap* receiver, std::span<DepositSum> sums,
                         std::vector<std::vector<std::uint32_t>>& by_slab) {
   chooseOnce();
   const DepositSlabFn deposit = runnableTargets()[current_index.load()].deposit;

@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <string>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -46,8 +47,8 @@ constexpr double kMeanTrackDecay = 1e-3;
 // The track deposits of one step: for each patch-step i with results[i].track (and not rolled
 // back), its lattice of sub-paths from results[i].from to patches[i].x, added to `sums` (one per
 // voxel of `grid`). `by_slab` is scratch space kept between calls.
-void applyTrackDeposits(const std::vector<Patch>& patches, const std::vector<PatchStepResult>& results,
-                        const GridSpec& grid, const ReceiverMap* receiver, std::vector<DepositSum>& sums,
+void applyTrackDeposits(std::span<const Patch> patches, std::span<const PatchStepResult> results,
+                        const GridSpec& grid, const ReceiverMap* receiver, std::span<DepositSum> sums,
                         std::vector<std::vector<std::uint32_t>>& by_slab);
 
 // The SIMD targets this build has code for and this CPU runs, best first ("AVX3", "AVX2", "SSE4",
