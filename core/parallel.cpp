@@ -56,6 +56,17 @@ class WorkerPool {
     return true;
   }
 
+  // Starts `helpers` threads (those missing), unless the pool is busy.
+  void start(unsigned helpers) {
+    bool idle = false;
+    if (!busy_.compare_exchange_strong(idle, true)) return;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      while (threads_.size() < helpers) threads_.emplace_back([this] { serve(); });
+    }
+    busy_.store(false);
+  }
+
   ~WorkerPool() {
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -103,6 +114,11 @@ unsigned workerThreads() {
     if (n > 0) return static_cast<unsigned>(n);
   }
   return hardwareThreads();
+}
+
+void startWorkerThreads() {
+  const unsigned threads = workerThreads();
+  if (threads > 1) WorkerPool::instance().start(threads - 1);
 }
 
 void parallelFor(std::int64_t begin, std::int64_t end, const std::function<void(std::int64_t)>& body,

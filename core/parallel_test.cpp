@@ -5,7 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <mutex>
 #include <cstdint>
 #include <numeric>
 #include <stdexcept>
@@ -14,6 +17,8 @@
 
 namespace eik {
 namespace {
+
+std::thread::id caller;  // the test's own thread
 
 // Marks each index of [0, n) in `seen`; every mark must be exactly one.
 void expectEachIndexOnce(const std::vector<std::atomic<int>>& seen) {
@@ -52,6 +57,44 @@ TEST(ParallelFor, NestedAndConcurrentCallsFinish) {
   second.join();
   expectEachIndexOnce(seen);
   expectEachIndexOnce(other);
+}
+
+TEST(ParallelFor, ThreadsStartedEarlyServeTheCallsAndAStartWhileBusyIsLeftOut) {
+  // startWorkerThreads before any call (the viewer, before its driver loads), again, and from
+  // within a body while the kept threads run it (nothing started, nothing waited for): every call
+  // still visits every index once. A start that left the pool marked busy would send every later
+  // call to threads of its own, which the thread ids below tell apart (the kept ones repeat).
+  startWorkerThreads();
+  startWorkerThreads();
+  std::vector<std::atomic<int>> seen(4096);
+  parallelFor(0, 4096, [&](std::int64_t i) {
+    if (i % 512 == 0) startWorkerThreads();
+    seen[static_cast<std::size_t>(i)].fetch_add(1);
+  });
+  expectEachIndexOnce(seen);
+  if (workerThreads() < 2) GTEST_SKIP() << "one worker thread: nothing kept";
+  auto helperIds = [] {
+    std::mutex m;
+    std::vector<std::thread::id> ids;
+    // Until a helper has taken an index (on a loaded machine the caller may take them all first).
+    for (int attempt = 0; attempt < 100 && ids.empty(); ++attempt)
+      parallelFor(0, 64, [&](std::int64_t) {
+        std::this_thread::sleep_for(std::chrono::microseconds(200));  // each thread gets some indices
+        std::lock_guard<std::mutex> lock(m);
+        if (std::this_thread::get_id() != caller) ids.push_back(std::this_thread::get_id());
+      });
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    return ids;
+  };
+  caller = std::this_thread::get_id();
+  const std::vector<std::thread::id> first = helperIds();
+  std::vector<std::thread> keep_alive;  // new threads started meanwhile would get fresh ids
+  for (int k = 0; k < 3; ++k) keep_alive.emplace_back([] { std::this_thread::sleep_for(std::chrono::milliseconds(50)); });
+  const std::vector<std::thread::id> second = helperIds();
+  for (std::thread& t : keep_alive) t.join();
+  ASSERT_FALSE(first.empty());
+  EXPECT_EQ(first, second) << "the kept threads serve both calls";
 }
 
 TEST(ParallelFor, CarriesTheBodysExceptionToTheCallerAndStaysUsable) {

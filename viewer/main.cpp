@@ -26,6 +26,7 @@
 #include "core/cli.h"
 #include "core/error.h"
 #include "core/image_io.h"
+#include "core/parallel.h"
 #include "core/scene.h"
 #include "core/volume.h"
 #include "gl/context.h"
@@ -186,7 +187,10 @@ int run(int argc, char** argv) {
   gl::ContextOptions context_options;
   context_options.backend = gl::parseGlBackend(gl_backend);
   std::optional<gl::DriverPreload> preload;
-  if (!window_mode) preload.emplace(context_options);
+  if (!window_mode) {
+    startWorkerThreads();  // before the driver's load, which would hold up their start (parallel.h)
+    preload.emplace(context_options);
+  }
   SceneLoadOptions load_options;
   load_options.leave_constant_optics_unread = !output.empty() && !bench;  // a headless render
   LoadedScene scene = loadScene(input, load_options);
