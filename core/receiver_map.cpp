@@ -10,7 +10,7 @@ namespace eik {
 
 NrrdHeader ReceiverMap::nrrdHeader() const {
   NrrdHeader header;
-  header.components = 3;
+  header.components = components;
   header.sizes = {texels.x, texels.y, 1};
   header.origin = texelCenter(0, 0);
   header.directions = glm::dmat3(pitch * u, pitch * v, pitch * normal);
@@ -28,7 +28,22 @@ nlohmann::json ReceiverMap::toJson(const std::string& file) const {
           {"origin", {origin.x, origin.y}},
           {"pitch", pitch},
           {"texels", {texels.x, texels.y}},
-          {"quantity", "planar irradiance, W/m^2, RGB"}};
+          {"quantity", components == 1 ? "planar irradiance, W/m^2, grey (R = G = B)" : "planar irradiance, W/m^2, RGB"}};
+}
+
+bool ReceiverMap::makeGrey() {
+  if (components == 1) return true;
+  const std::size_t n = texelCount();
+  if (irradiance.size() != 3 * n) return false;
+  for (std::size_t t = 0; t < n; ++t) {
+    const float* e = &irradiance[3 * t];
+    // Equal values (a NaN never is; a −0 beside a +0 reads back as the first).
+    if (!(e[0] == e[1] && e[1] == e[2])) return false;
+  }
+  for (std::size_t t = 0; t < n; ++t) irradiance[t] = irradiance[3 * t];
+  irradiance.resize(n);
+  components = 1;
+  return true;
 }
 
 void receiverAxes(const glm::dvec3& normal, glm::dvec3& u, glm::dvec3& v) {
@@ -112,7 +127,8 @@ ReceiverMap receiverFromJson(const nlohmann::json& j, const std::string& source,
 
 void checkReceiverHeader(const ReceiverMap& map, const NrrdHeader& header, const std::string& source,
                          const std::string& key, const std::string& nrrd) {
-  if (header.components != 3) throw InputError(source, key, nrrd + ": expected 3 components (RGB)");
+  if (header.components != 1 && header.components != 3)
+    throw InputError(source, key, nrrd + ": expected 3 components (RGB) or 1 (grey)");
   if (header.sizes != glm::ivec3(map.texels.x, map.texels.y, 1))
     throw InputError(source, key, nrrd + ": sizes do not match the manifest's texels");
   const NrrdHeader expected = map.nrrdHeader();

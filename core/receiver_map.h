@@ -29,9 +29,21 @@ struct ReceiverMap {
   glm::dvec2 origin{0.0};           // (u, v) of the map's corner, relative to `point`
   double pitch = 0.0;               // texel edge, world units
   glm::ivec2 texels{0};
-  std::vector<float> irradiance;    // RGB per texel, u fastest; W/m²
+  // Per texel, u fastest, W/m²: RGB (components 3), or one value where the three are equal in every
+  // texel (components 1, grey: a white light through clear glass; makeGrey), a third of the memory
+  // and of the file.
+  std::vector<float> irradiance;
+  int components = 3;
 
   std::size_t texelCount() const { return static_cast<std::size_t>(texels.x) * static_cast<std::size_t>(texels.y); }
+  // Texel t's RGB irradiance, whichever the layout.
+  glm::vec3 rgb(std::size_t t) const {
+    if (components == 1) return glm::vec3(irradiance[t]);
+    return {irradiance[3 * t], irradiance[3 * t + 1], irradiance[3 * t + 2]};
+  }
+  // An RGB map whose every texel holds three equal values becomes grey, in place (lossless);
+  // any other map is left as it is. True when the map is grey afterwards.
+  bool makeGrey();
   // World position of the centre of texel (i, j).
   glm::dvec3 texelCenter(int i, int j) const {
     return point + (origin.x + (i + 0.5) * pitch) * u + (origin.y + (j + 0.5) * pitch) * v;
@@ -51,9 +63,10 @@ struct ReceiverMap {
     g.origin = origin;
     g.pitch = pitch;
     g.texels = texels;
+    g.components = components;
     return g;
   }
-  // The oriented NRRD header of the map (3 components).
+  // The oriented NRRD header of the map (`components` components).
   NrrdHeader nrrdHeader() const;
   // The manifest entry, with `file` the NRRD's name relative to the manifest.
   nlohmann::json toJson(const std::string& file) const;
@@ -68,8 +81,9 @@ void receiverAxes(const glm::dvec3& normal, glm::dvec3& u, glm::dvec3& v);
 ReceiverMap receiverFromJson(const nlohmann::json& j, const std::string& source, const std::string& key,
                              std::string& file);
 
-// Checks that a NRRD header is the one `map` needs (components, texels, orientation, tolerance
-// 1e-4 of the pitch); InputError naming `source` and `key` otherwise.
+// Checks that a NRRD header is the one `map` needs (1 or 3 components, texels, orientation,
+// tolerance 1e-4 of the pitch); InputError naming `source` and `key` otherwise. The caller takes
+// the map's `components` from the header.
 void checkReceiverHeader(const ReceiverMap& map, const NrrdHeader& header, const std::string& source,
                          const std::string& key, const std::string& nrrd);
 

@@ -68,6 +68,49 @@ TEST(ReceiverMap, RoundTripsThroughAVolume) {
   EXPECT_FALSE(readVolumeHeader(dir / "r.vol.json").receivers.empty());
 }
 
+// A map whose channels agree in every texel (a white light through clear glass) is kept and
+// written grey, one value a texel, and reads back as it was; one texel that differs keeps it RGB.
+TEST(ReceiverMap, AGreyMapKeepsOneValueATexelOnDiskAndReadsBackTheSame) {
+  ReceiverMap grey = sampleMap();
+  for (std::size_t t = 0; t < grey.texelCount(); ++t)
+    for (int c = 0; c < 3; ++c) grey.irradiance[3 * t + static_cast<std::size_t>(c)] = 0.25f * static_cast<float>(t);
+  ReceiverMap coloured = grey;
+  coloured.irradiance[3 * 17 + 2] += 1e-6f;  // one channel of one texel off: not grey
+  EXPECT_FALSE(coloured.makeGrey());
+  EXPECT_EQ(coloured.components, 3);
+  EXPECT_EQ(coloured.irradiance.size(), 3 * coloured.texelCount());
+  const ReceiverMap rgb = grey;
+  ASSERT_TRUE(grey.makeGrey());
+  EXPECT_EQ(grey.components, 1);
+  ASSERT_EQ(grey.irradiance.size(), grey.texelCount());
+  for (std::size_t t = 0; t < grey.texelCount(); ++t) ASSERT_EQ(grey.rgb(t), rgb.rgb(t)) << t;
+
+  TempDir dir;
+  Volume v;
+  v.grid.dims = {2, 2, 2};
+  v.grid.bounds_max = glm::dvec3(1.0);
+  v.addField("ior", 1);
+  v.receivers = {grey, coloured};
+  v.receivers[1].name = "coloured";
+  const std::string generation = writeVolume(v, dir / "g.vol.json");
+  EXPECT_EQ(readNrrdHeader(dir / ("g." + generation + ".receiver-ground.nrrd")).components, 1);
+  EXPECT_EQ(readNrrdHeader(dir / ("g." + generation + ".receiver-coloured.nrrd")).components, 3);
+  const nlohmann::json manifest = nlohmann::json::parse(test_support::readFile(dir / "g.vol.json"));
+  EXPECT_CONTAINS(manifest["receivers"][0]["quantity"].get<std::string>(), "grey");
+  EXPECT_CONTAINS(manifest["receivers"][1]["quantity"].get<std::string>(), "RGB");
+  const Volume back = readVolume(dir / "g.vol.json");
+  ASSERT_EQ(back.receivers.size(), 2u);
+  EXPECT_EQ(back.receivers[0].components, 1);
+  EXPECT_EQ(back.receivers[0].irradiance, grey.irradiance);
+  EXPECT_EQ(back.receivers[1].components, 3);
+  EXPECT_EQ(back.receivers[1].irradiance, coloured.irradiance);
+  // A map of any other number of components is refused, naming the file.
+  NrrdHeader two = grey.nrrdHeader();
+  two.components = 2;
+  EXPECT_CONTAINS(inputErrorOf([&] { checkReceiverHeader(grey, two, "v.json", "receivers[0]", "m.nrrd"); }),
+                  "m.nrrd: expected 3 components (RGB) or 1 (grey)");
+}
+
 TEST(ReceiverMap, MalformedEntriesNameTheKey) {
   std::string file;
   nlohmann::json good = sampleMap().toJson("x.nrrd");

@@ -288,6 +288,7 @@ class ManifestReader {
         throw InputError(name_ + ": " + key + ": " + e.what());
       }
       checkReceiverHeader(map, header, name_, key, path.string());
+      map.components = header.components;
       checkGeneration(key, path, header);
       if (with_data) {
         checkMemoryLimit(name_, key, fieldBytes(header.sizes, header.components));
@@ -663,9 +664,11 @@ std::string writeVolume(const Volume& volume, const fs::path& manifest, const Vo
   for (const ReceiverMap& map : volume.receivers) {
     if (!isValidFieldName(map.name))
       throw RuntimeError(name + ": receivers." + map.name + ": a receiver name may hold only letters, digits, '_' and '-'");
-    if (map.irradiance.size() != map.texelCount() * 3)
+    if ((map.components != 1 && map.components != 3) ||
+        map.irradiance.size() != map.texelCount() * static_cast<std::size_t>(map.components))
       throw RuntimeError(name + ": receivers." + map.name + ": " + std::to_string(map.irradiance.size()) +
-                         " values for " + std::to_string(map.texelCount()) + " RGB texels");
+                         " values for " + std::to_string(map.texelCount()) + " texels of " +
+                         std::to_string(map.components) + " components");
     const fs::path file = dir / (prefix + "receiver-" + map.name + extension);
     stage(file, map.nrrdHeader(), map.irradiance);
     receivers.push_back(nlohmann::ordered_json::parse(map.toJson(file.filename().string()).dump()));

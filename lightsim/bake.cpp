@@ -129,6 +129,9 @@ void applyBake(Volume& volume, BakeResult&& result, const LightSpec& light) {
     volume.fields["light_dir"] = std::move(result.light_dir);
   }
   volume.receivers = std::move(result.receivers);
+  // A map whose three channels agree everywhere (a white light through clear glass) is kept grey:
+  // a third of its memory, of its file and of what the viewer reads (ReceiverMap::makeGrey).
+  for (ReceiverMap& map : volume.receivers) map.makeGrey();
   volume.metadata["light"] = light.toJson();
   volume.metadata.erase("lights");
   volume.metadata["bake_stats"] = result.stats.toJson();

@@ -13,8 +13,8 @@
 namespace eik {
 
 // Adds (or replaces) the fields `irradiance` (RGB, W/m²) and `light_dir` (unit, 0 where no light
-// passed) and the manifest entries "light" (LightSpec::toJson) and "bake_stats"
-// (SimulationStats::toJson). Throws std::invalid_argument when the result's fields do not fit the
+// passed), the result's receiver maps (grey where their channels agree: ReceiverMap::makeGrey) and
+// the manifest entries "light" (LightSpec::toJson) and "bake_stats" (SimulationStats::toJson). Throws std::invalid_argument when the result's fields do not fit the
 // volume's grid (3 components, one per voxel).
 void applyBake(Volume& volume, const BakeResult& result, const LightSpec& light);
 // The same for a bake of several lights summed (a scene's): "light" the first, whose direct light

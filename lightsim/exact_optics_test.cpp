@@ -54,7 +54,7 @@ Rings ringsOf(const ReceiverMap& map) {
     for (int i = 0; i < map.texels.x; ++i) {
       const glm::dvec3 c = map.texelCenter(i, j);
       const double r = std::hypot(c.x, c.z);
-      const double e = map.irradiance[3 * (static_cast<std::size_t>(j) * map.texels.x + i)];
+      const double e = map.rgb(static_cast<std::size_t>(j) * map.texels.x + i).x;
       if (r < 0.2) rings.encircled_02 += e * a;
       if (r < 1.0) rings.encircled_1 += e * a;
       for (int k = 0; k < Rings::kCount; ++k)
@@ -198,9 +198,9 @@ SphereBake measureSphereBake(int res, const BakeResult& bake) {
     for (int i = 0; i < map.texels.x; ++i) {
       const glm::dvec3 c = map.texelCenter(i, j);
       if (std::hypot(c.x, c.z) <= 1.3) continue;
-      const std::size_t t = 3 * (static_cast<std::size_t>(j) * map.texels.x + i);
-      bake_sum += map.irradiance[t];
-      exact_sum += exact_map.irradiance[t];
+      const std::size_t t = static_cast<std::size_t>(j) * map.texels.x + i;
+      bake_sum += map.rgb(t).x;
+      exact_sum += exact_map.rgb(t).x;
       ++outside;
     }
   std::printf("%d³: beyond r = 1.3 (%d texels): bake %.5f, exact through the map %.5f\n", res, outside,
@@ -379,7 +379,7 @@ Penumbra penumbraOf(const ReceiverMap& map, const PenumbraWindow& window = {}) {
     for (int i = 0; i < map.texels.x; ++i) {
       const glm::dvec3 c = map.texelCenter(i, j);
       const double r = std::hypot(c.x, c.z);
-      const double e = map.irradiance[3 * (static_cast<std::size_t>(j) * map.texels.x + i) + 1];
+      const double e = map.rgb(static_cast<std::size_t>(j) * map.texels.x + i).y;
       if (r >= window.inside_lo && r < window.inside_hi) inside += e, n_inside += 1.0;
       if (r >= window.outside_lo && r < window.outside_hi) outside += e, n_outside += 1.0;
       const int b = static_cast<int>((r - kFrom) / kBin);
@@ -903,7 +903,7 @@ double worstFreeAirDeviation(int res, const glm::dvec3& direction, double* map_d
   const double expected = 2.0 * -light.direction.y;  // planar irradiance: E·cos θ
   *map_deviation = 0.0;
   for (std::size_t t = 0; t < map.texelCount(); ++t)
-    *map_deviation = std::max(*map_deviation, std::abs(map.irradiance[3 * t] / expected - 1.0));
+    *map_deviation = std::max(*map_deviation, std::abs(map.rgb(t).x / expected - 1.0));
   return worst;
 }
 
@@ -973,7 +973,7 @@ std::pair<double, double> pointLightOverAFloor(double patch_voxels) {
       const glm::dvec3 c = map.texelCenter(i, j);
       const double d = glm::length(c - light.position);
       const double want = 3.0 * h / (d * d * d);
-      const double got = map.irradiance[3 * (static_cast<std::size_t>(j) * map.texels.x + i)];
+      const double got = map.rgb(static_cast<std::size_t>(j) * map.texels.x + i).x;
       // Through the box: the texels the followed patches may reach (their centre rays meet the box
       // grown by lightsim's voxel of margin, and they reach half a patch beyond): the box grown by
       // 2 voxels.
@@ -1038,7 +1038,7 @@ TEST(ExactOpticsFreeAir, ASpotLightsConeEndsWhereItsOuterAngleMeetsTheFloor) {
       const double d = glm::length(c - light.position), cos_theta = h / d;
       const double t = std::clamp((cos_theta - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
       const double want = 3.0 * t * t * h / (d * d * d);
-      const double got = map.irradiance[3 * (static_cast<std::size_t>(j) * map.texels.x + i)];
+      const double got = map.rgb(static_cast<std::size_t>(j) * map.texels.x + i).x;
       const double radius = std::hypot(c.x, c.z);
       if (want > 0.0) worst = std::max(worst, std::abs(got / want - 1.0));
       else EXPECT_EQ(got, 0.0) << "outside the cone at r = " << radius;
@@ -1107,7 +1107,7 @@ TEST(ExactOpticsSlab, ShiftsTheBeamBySnellsLawAndTransmitsTheFresnelFraction) {
   const BakeResult r = sim.run(light, options);
   const ReceiverMap& map = r.receivers.at(0);
   double mean = 0.0;
-  for (std::size_t t = 0; t < map.texelCount(); ++t) mean += map.irradiance[3 * t];
+  for (std::size_t t = 0; t < map.texelCount(); ++t) mean += map.rgb(t).x;
   mean /= static_cast<double>(map.texelCount());
   const double R = reference::fresnelReflectance(1.0, n, std::cos(theta_i));
   const double expected = std::cos(theta_i) * (1.0 - R) * (1.0 - R);
@@ -1228,7 +1228,7 @@ TEST(ExactOpticsSlab, StraightStepsKeepBeerLambertInAnAbsorbingLiquid) {
         const BakeResult r = sim->run(light, o);
         const ReceiverMap& map = r.receivers.at(0);
         double mean = 0.0;
-        for (std::size_t t = 0; t < map.texelCount(); ++t) mean += map.irradiance[3 * t];
+        for (std::size_t t = 0; t < map.texelCount(); ++t) mean += map.rgb(t).x;
         mean /= static_cast<double>(map.texelCount());
         std::printf("two slabs, %s, σa %s, %s: transmitted %.6f, exact %.6f (%+.3f %%), %llu patch-steps\n",
                     r.stats.backend.c_str(), by_material ? "per material" : "field",
@@ -1264,7 +1264,7 @@ TEST(ExactOpticsSlab, StraightStepsKeepBeerLambertInAnAbsorbingLiquid) {
     const BakeResult r = simulatorFor(coarse, backend)->run(light, straight);
     const ReceiverMap& map = r.receivers.at(0);
     double mean = 0.0;
-    for (std::size_t t = 0; t < map.texelCount(); ++t) mean += map.irradiance[3 * t];
+    for (std::size_t t = 0; t < map.texelCount(); ++t) mean += map.rgb(t).x;
     mean /= static_cast<double>(map.texelCount());
     std::printf("two slabs at 32³, %s, σa per material, straight steps: transmitted %.6f (%+.3f %%)\n",
                 r.stats.backend.c_str(), mean, 100.0 * (mean / expected - 1.0));

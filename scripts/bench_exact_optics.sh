@@ -230,6 +230,8 @@ cpu=$(awk -F': ' '/model name/ { print $2; exit }' /proc/cpuinfo)
     "viewer: ${EIKONAL_GL:-auto} OpenGL (llvmpipe unless a GPU's EGL is picked)$([ "$pov" = 1 ] && echo "; POV-Ray +WT2")."
   echo "Camera (viewer and POV-Ray): eye ($eye), target ($target), fov_y $fov_y°, ${width}x$height, 1 ray/pixel."
   echo "Exact row: E in W/m², Φ in W. Other rows: ratio to exact per ring, deviation of Φ, shadow radius."
+  echo "The row under it: the tracer's own noise per ring (1σ of its mean E, from the paths it counted); a"
+  echo "deviation below it is not resolved ($rays rays: --quick's 10⁶ leave ±1.6 % in the ring 0.6-0.9)."
   echo "Times: median of $repeats runs of each command (wall seconds)."
   echo "Image rows (viewer, POV-Ray) point-sample the floor once per pixel (footprint about 0.011 x 0.025 near"
   echo "the caustic), which undersamples its core (a quarter of the flux of the ring 0-0.1 lies within r < 0.01):"

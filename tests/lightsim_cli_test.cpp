@@ -431,7 +431,7 @@ TEST(LightsimCli, EveryLightOfTheSceneIsBakedAndSummed) {
     const glm::dvec2 uv = (map.planeCoordinates(glm::dvec3(x, -1.2, 0.0)) - map.origin) / map.pitch;
     const int i = static_cast<int>(uv.x), j = static_cast<int>(uv.y);
     EXPECT_TRUE(i >= 0 && j >= 0 && i < map.texels.x && j < map.texels.y) << x;
-    return map.irradiance.at(3 * (static_cast<std::size_t>(j) * map.texels.x + i) + 1);
+    return map.rgb(static_cast<std::size_t>(j) * map.texels.x + i).y;
   };
   // x = −0.4: under the slab for the first sun, in the open for the second (its shadow, through the
   // slab, lies over 0.4–1.8); x = 1.3: the other way round; x = 2.4: open to both. Each a few
@@ -492,7 +492,7 @@ TEST(LightsimCli, BakesADispersiveVolumeBandByBand) {
     EXPECT_NEAR(rest / in, 1.0, 1e-6) << bands;
     EXPECT_LT(f["ledger_relative_residual"].get<double>(), 1e-6) << bands;
     for (std::size_t t = 0; t < baked.receivers.at(0).texelCount(); ++t)
-      totals[bands == 16] += baked.receivers[0].irradiance[3 * t + 1];
+      totals[bands == 16] += baked.receivers[0].rgb(t).y;
   }
   EXPECT_NEAR(totals[1] / totals[0], 1.0, 0.01);
   ProgramResult plain = runProgram(LIGHTSIM_EXE,

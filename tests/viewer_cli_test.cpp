@@ -2,6 +2,7 @@
 // with a clear message for bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -243,6 +244,61 @@ TEST(ViewerCli, RendersABakedSceneWithGroundSkyAndTwoObjects) {
   Image flags = readImage(dir / "flags.exr");
   const float cell = flags.at(2, 47)[1];
   EXPECT_TRUE(std::abs(cell - 1.0f) < 1e-3f || std::abs(cell - 0.2f) < 1e-3f) << cell;
+}
+
+// A white light through clear glass bakes a grey receiver map, written with one value a texel
+// (ReceiverMap::makeGrey) and uploaded as RG16F (RECEIVER_GREY); the same map written as RGB,
+// which the viewer uploads as RGBA16F, must give the same image to the bit. A coloured light
+// keeps its map RGB.
+TEST(ViewerCli, AGreyReceiverMapRendersAsItsRgbTwin) {
+  TempDir dir;
+  ProgramResult r = runProgram(VOXELIZE_EXE,
+                               {"procedural:sphere,r=0.4,ior=1.5", "-o", "glass.vol.json", "--res", "24",
+                                "--bounds", "-1,-0.9,-1,1,1.1,1", "--quiet"},
+                               dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* power : {"1,1,1", "1,0.5,0.25"}) {
+    r = runProgram(LIGHTSIM_EXE,
+                   {"glass.vol.json", "-o", std::string(power) == "1,1,1" ? "grey.vol.json" : "coloured.vol.json",
+                    "--light", "directional:0,-1,0", "--power", power, "--receiver", "0,-0.8,0:0,1,0:2", "--quiet"},
+                   dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  EXPECT_EQ(readVolume(dir / "coloured.vol.json").receivers.at(0).components, 3);
+  Volume rgb = readVolume(dir / "grey.vol.json");
+  ASSERT_EQ(rgb.receivers.at(0).components, 1);
+  ReceiverMap& map = rgb.receivers[0];
+  std::vector<float> expanded(3 * map.texelCount());
+  for (std::size_t t = 0; t < map.texelCount(); ++t)
+    for (int c = 0; c < 3; ++c) expanded[3 * t + static_cast<std::size_t>(c)] = map.irradiance[t];
+  map.irradiance = std::move(expanded);
+  map.components = 3;
+  writeVolume(rgb, dir / "rgb.vol.json");
+  ASSERT_EQ(readVolume(dir / "rgb.vol.json").receivers.at(0).components, 3);
+  auto render = [&](const std::string& volume) {
+    writeFile(dir / "scene.json", R"({
+      "camera": {"eye": [0, 2.0, 2.5], "target": [0, -0.8, 0], "up": [0, 1, 0], "fov_y_deg": 40},
+      "environment": {"uniform": [0.2, 0.2, 0.2]},
+      "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": [1, 1, 1]}],
+      "ground": {"point": [0, -0.8, 0], "normal": [0, 1, 0], "albedo": [0.8, 0.8, 0.8], "half_extent": 4},
+      "objects": [{"volume": ")" + volume + R"("}],
+      "render": {"size": [48, 40], "tonemap": "linear"}})");
+    ProgramResult v = runProgram(VIEWER_EXE, {"scene.json", "--render", volume + ".exr", "--quiet"}, dir.path());
+    EXPECT_EQ(v.exit_code, 0) << v.output;
+    return readImage(dir / (volume + ".exr"));
+  };
+  const Image grey = render("grey.vol.json"), twin = render("rgb.vol.json");
+  ASSERT_EQ(grey.pixels.size(), twin.pixels.size());
+  EXPECT_EQ(grey.pixels, twin.pixels);
+  // The map is read: the ground under the ball (its caustic and shadow) differs from the open ground.
+  float hi = 0.0f;  // the open ground in the bottom row
+  for (int x = 0; x < grey.width; ++x) hi = std::max(hi, grey.at(x, grey.height - 1)[1]);
+  float centre_lo = 1e30f, centre_hi = 0.0f;
+  for (int y = grey.height / 2; y < grey.height; ++y) {
+    centre_lo = std::min(centre_lo, grey.at(grey.width / 2, y)[1]);
+    centre_hi = std::max(centre_hi, grey.at(grey.width / 2, y)[1]);
+  }
+  EXPECT_GT(centre_hi - centre_lo, 0.5f * hi) << "no caustic or shadow on the ground";
 }
 
 }  // namespace

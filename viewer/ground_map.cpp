@@ -45,14 +45,13 @@ bool receiverChangeAt(const ReceiverLayer& layer, const glm::dvec3& xw, glm::dve
   const glm::dvec2 at = st * glm::dvec2(map.texels) - 0.5;
   const int i0 = static_cast<int>(std::floor(at.x)), j0 = static_cast<int>(std::floor(at.y));
   const double fx = at.x - i0, fy = at.y - j0;
-  const int channels = layer.texels ? 4 : 3;
-  const std::vector<float>& data = layer.texels ? *layer.texels : map.irradiance;
   auto texel = [&](int i, int j) {
     i = std::clamp(i, 0, map.texels.x - 1);
     j = std::clamp(j, 0, map.texels.y - 1);
-    const float* e = &data[static_cast<std::size_t>(channels) *
-                           (static_cast<std::size_t>(j) * static_cast<std::size_t>(map.texels.x) + static_cast<std::size_t>(i))];
-    return glm::dvec4(e[0], e[1], e[2], channels == 4 ? e[3] : 1.0);
+    const std::size_t t = static_cast<std::size_t>(j) * static_cast<std::size_t>(map.texels.x) + static_cast<std::size_t>(i);
+    if (!layer.texels) return glm::dvec4(glm::dvec3(map.rgb(t)), 1.0);
+    const float* e = &(*layer.texels)[4 * t];
+    return glm::dvec4(e[0], e[1], e[2], e[3]);
   };
   const glm::dvec4 E = (1 - fx) * (1 - fy) * texel(i0, j0) + fx * (1 - fy) * texel(i0 + 1, j0) +
                        (1 - fx) * fy * texel(i0, j0 + 1) + fx * fy * texel(i0 + 1, j0 + 1);

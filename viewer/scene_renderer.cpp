@@ -41,6 +41,7 @@ struct SceneRenderer::Impl {
     std::string defines;   // RaymarchObject::defines: its interfaces, HAS_RECEIVER
     // The receiver map of the scene's ground, when its bake made one (volume space).
     bool has_receiver = false;
+    bool receiver_grey = false;  // the texture is RG16F: R = G = B, and the clearance (receiverTexelsHalf)
     ReceiverMap receiver;   // geometry (the data is in receiver_texture)
     gl::Texture2D receiver_texture;
     glm::vec4 receiver_light_pos{0.0f};
@@ -180,11 +181,15 @@ struct SceneRenderer::Impl {
     // With its irradiance for the ground map only (a lone object's is uploaded as its texels; the
     // copy would be 12 MB of fresh memory at 1024² texels).
     o.receiver = for_ground_map ? *found.map : found.map->geometry();
-    // RGBA16F: sampled once a ground hit, half the memory of RGBA32F (receiverTexelsHalf).
-    o.receiver_texture = gl::Texture2D(found.map->texels, gl::TextureFormat::RGBA16F);
+    // RGBA16F: sampled once a ground hit, half the memory of RGBA32F; RG16F (R = G = B, and A)
+    // for a grey map of grey lights (receiverTexelsHalf).
     const std::vector<std::uint16_t> texels = prepared ? std::vector<std::uint16_t>() : groundTexels(loaded, found);
     const std::vector<std::uint16_t>& half = prepared ? *prepared : texels;
-    o.receiver_texture.uploadRaw(half.data(), half.size() * sizeof(std::uint16_t), GL_RGBA, GL_HALF_FLOAT);
+    o.receiver_grey = half.size() == 2 * found.map->texelCount();
+    o.receiver_texture =
+        gl::Texture2D(found.map->texels, o.receiver_grey ? gl::TextureFormat::RG16F : gl::TextureFormat::RGBA16F);
+    o.receiver_texture.uploadRaw(half.data(), half.size() * sizeof(std::uint16_t), o.receiver_grey ? GL_RG : GL_RGBA,
+                                 GL_HALF_FLOAT);
     o.has_receiver = true;
   }
 
@@ -241,6 +246,7 @@ struct SceneRenderer::Impl {
       throw RuntimeError("viewer: expected ior and ior_grad together in one RGBA texture");
     if (scene.ground) attachReceiver(o, loaded, *scene.ground, prepared_texels, scene.objects.size() > 1);
     if (o.has_receiver) o.defines += "#define HAS_RECEIVER 1\n";
+    if (o.has_receiver && o.receiver_grey) o.defines += "#define RECEIVER_GREY 1\n";
     // The homogeneous bricks only where the march skips them (SKIP_HOMOGENEOUS, `--bricks`): at 132³
     // their analysis reads every voxel's n and σa through 15 MB of fresh arrays. Otherwise one brick
     // that is not homogeneous, which a program built with them later (setSettings) reads as no skip.

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <span>
+#include <stdexcept>
 #include <type_traits>
 
 #include "core/half_float.h"
@@ -332,11 +333,13 @@ std::vector<float> shadowClearance(const Volume& volume, const ReceiverMap& map,
 
 namespace {
 
-// receiverTexels, each texel's RGBA stored as `Out` (float, or half bits through toHalf).
+// receiverTexels, each texel's RGBA stored as `Out` (float, or half bits through toHalf); with
+// `grey`, only its R and A (receiverTexelsGrey).
 template <typename Out>
-std::vector<Out> texelsOf(const ReceiverLayer& layer, const std::vector<float>& clearance) {
+std::vector<Out> texelsOf(const ReceiverLayer& layer, const std::vector<float>& clearance, bool grey = false) {
   const ReceiverMap& map = *layer.map;
   const std::size_t n = map.texelCount();
+  const std::size_t channels = grey ? 2 : 4;
   const bool edges = clearance.size() == n;
   const int nx = map.texels.x, ny = map.texels.y;
   auto c = [&](int i, int j) {
@@ -369,7 +372,7 @@ std::vector<Out> texelsOf(const ReceiverLayer& layer, const std::vector<float>& 
     return lit / 64.0;
   };
   const glm::dvec3 normal = glm::cross(map.u, map.v);
-  std::vector<Out> rgba(4 * n);
+  std::vector<Out> rgba(channels * n);
   parallelFor(
       0, ny,
       [&](std::int64_t row) {
@@ -379,6 +382,7 @@ std::vector<Out> texelsOf(const ReceiverLayer& layer, const std::vector<float>& 
         thread_local std::vector<float> buffer;
         float* out_row = nullptr;
         if constexpr (std::is_same_v<Out, float>) {
+          if (grey) throw std::logic_error("receiverTexels: grey texels are halves only");
           out_row = &rgba[4 * first];
         } else {
           buffer.resize(4 * static_cast<std::size_t>(nx));
@@ -387,7 +391,8 @@ std::vector<Out> texelsOf(const ReceiverLayer& layer, const std::vector<float>& 
         for (int i = 0; i < nx; ++i) {
           const std::size_t t = first + static_cast<std::size_t>(i);
           float* out = out_row + 4 * static_cast<std::size_t>(i);
-          for (int k = 0; k < 3; ++k) out[k] = map.irradiance[3 * t + static_cast<std::size_t>(k)];
+          const glm::vec3 e = map.rgb(t);
+          for (int k = 0; k < 3; ++k) out[k] = e[k];
           out[3] = edges ? clearance[t] : 1.0f;
           if (!layer.other_lights.empty()) {
             const glm::dvec3 others = otherLightsIrradiance(layer, map.texelCenter(i, j), normal);
@@ -399,8 +404,15 @@ std::vector<Out> texelsOf(const ReceiverLayer& layer, const std::vector<float>& 
             for (int k = 0; k < 3; ++k) out[k] += static_cast<float>(D[k] * shaded);
           }
         }
-        if constexpr (!std::is_same_v<Out, float>)
-          toHalf(std::span<const float>(buffer), std::span<std::uint16_t>(&rgba[4 * first], buffer.size()));
+        if constexpr (!std::is_same_v<Out, float>) {
+          if (grey)  // R and A of each texel, packed in place (G and B equal R: greyReceiverTexels)
+            for (std::size_t i = 0; i < static_cast<std::size_t>(nx); ++i) {
+              buffer[2 * i] = buffer[4 * i];
+              buffer[2 * i + 1] = buffer[4 * i + 3];
+            }
+          const std::size_t count = channels * static_cast<std::size_t>(nx);
+          toHalf(std::span<const float>(buffer.data(), count), std::span<std::uint16_t>(&rgba[channels * first], count));
+        }
       },
       16);
   return rgba;
@@ -413,7 +425,15 @@ std::vector<float> receiverTexels(const ReceiverLayer& layer, const std::vector<
 }
 
 std::vector<std::uint16_t> receiverTexelsHalf(const ReceiverLayer& layer, const std::vector<float>& clearance) {
-  return texelsOf<std::uint16_t>(layer, clearance);
+  return texelsOf<std::uint16_t>(layer, clearance, greyReceiverTexels(layer));
+}
+
+bool greyReceiverTexels(const ReceiverLayer& layer) {
+  auto grey = [](const glm::dvec3& p) { return p.x == p.y && p.y == p.z; };
+  if (!layer.map || layer.map->components != 1 || !grey(layer.light_power)) return false;
+  for (const ReceiverLayer::Light& light : layer.other_lights)
+    if (!grey(light.power)) return false;
+  return true;
 }
 
 }  // namespace eik

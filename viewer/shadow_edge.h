@@ -49,6 +49,10 @@ std::vector<float> receiverTexels(const ReceiverLayer& layer, const std::vector<
 // The same as half floats (core/half_float.h), what the viewer uploads (RGBA16F): half the memory
 // of a texture sampled once a ground hit, within 2⁻¹¹ of each value (the shadow's edge, where the
 // bilinear c crosses 0, moves by far less than a texel: c's relative precision is the same near 0).
+// Where greyReceiverTexels, R and A alone (RG16F), R = G = B: a quarter of RGBA32F's memory.
 std::vector<std::uint16_t> receiverTexelsHalf(const ReceiverLayer& layer, const std::vector<float>& clearance);
+// Whether every texel's R, G and B are equal: a grey map (ReceiverMap::makeGrey) baked with grey
+// lights only (the light added back under the shadow and the other lights taken off are grey too).
+bool greyReceiverTexels(const ReceiverLayer& layer);
 
 }  // namespace eik

@@ -172,6 +172,24 @@ TEST(ShadowEdge, TheGroundShowsTheEdgeWhereTheClearanceChangesSign) {
   const std::vector<std::uint16_t> halves = receiverTexelsHalf(layer, clearance);
   ASSERT_EQ(halves.size(), texels.size());
   for (std::size_t k = 0; k < texels.size(); ++k) ASSERT_EQ(halves[k], toHalf(texels[k])) << k;
+  // The map is grey (R = G = B) and so is the light: kept grey (ReceiverMap::makeGrey), its texture
+  // is R and A alone, the same halves; a coloured light (its direct light added back under the
+  // shadow) or an RGB map keep all four.
+  EXPECT_FALSE(greyReceiverTexels(layer));  // the map is still RGB
+  ReceiverMap grey_map = map;
+  ASSERT_TRUE(grey_map.makeGrey());
+  ReceiverLayer grey_layer = layer;
+  grey_layer.map = &grey_map;
+  ASSERT_TRUE(greyReceiverTexels(grey_layer));
+  const std::vector<std::uint16_t> grey_halves = receiverTexelsHalf(grey_layer, clearance);
+  ASSERT_EQ(grey_halves.size(), 2 * map.texelCount());
+  for (std::size_t t = 0; t < map.texelCount(); ++t) {
+    ASSERT_EQ(grey_halves[2 * t], halves[4 * t]) << t;
+    ASSERT_EQ(grey_halves[2 * t + 1], halves[4 * t + 3]) << t;
+  }
+  grey_layer.light_power = glm::dvec3(D, D, 0.5 * D);
+  EXPECT_FALSE(greyReceiverTexels(grey_layer));
+  EXPECT_EQ(receiverTexelsHalf(grey_layer, clearance).size(), 4 * map.texelCount());
   // Texel 3 (u in [0.3, 0.4)) is the one the edge crosses: lit 7/10 of it; the 8×8 points find
   // 6/8 (those at u ≥ 0.33), so it gets D·(1 − 0.75) back. The others: nothing in the light, D
   // in the shadow.

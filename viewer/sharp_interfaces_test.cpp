@@ -319,7 +319,7 @@ double mapIrradiance(const ReceiverMap& map, const glm::dvec3& point) {
   auto texel = [&](int i, int j) {
     i = std::clamp(i, 0, map.texels.x - 1);
     j = std::clamp(j, 0, map.texels.y - 1);
-    return static_cast<double>(map.irradiance[3 * (static_cast<std::size_t>(j) * map.texels.x + i)]);
+    return static_cast<double>(map.rgb(static_cast<std::size_t>(j) * map.texels.x + i).x);
   };
   return (1 - fx) * (1 - fy) * texel(i0, j0) + fx * (1 - fy) * texel(i0 + 1, j0) + (1 - fx) * fy * texel(i0, j0 + 1) +
          fx * fy * texel(i0 + 1, j0 + 1);
@@ -417,7 +417,9 @@ TEST_F(SharpViewerTest, GroundTexelsPreparedBeforehandRenderTheSameImage) {
   const SceneRenderer::Preparation prepared = SceneRenderer::prepare(loaded);
   ASSERT_EQ(prepared.ground_texels.size(), 1u);
   ASSERT_TRUE(prepared.ground_texels[0].has_value()) << "the baked map lies in the ground's plane";
-  EXPECT_EQ(prepared.ground_texels[0]->size(), 4 * volume.receivers.at(0).texelCount());
+  // A white light's map is grey: its texels R and A alone (receiverTexelsHalf).
+  ASSERT_EQ(volume.receivers.at(0).components, 1);
+  EXPECT_EQ(prepared.ground_texels[0]->size(), 2 * volume.receivers.at(0).texelCount());
   const Camera camera{glm::dvec3(0.6, 1.2, 1.6), glm::dvec3(0.1, 0.0, 0.0), glm::dvec3(0, 1, 0), 40.0};
   const Image without = SceneRenderer(*shaders_, loaded, RenderSettings{}).render(camera, {64, 64});
   const Image with = SceneRenderer(*shaders_, loaded, RenderSettings{}, &prepared).render(camera, {64, 64});

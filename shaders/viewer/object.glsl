@@ -15,7 +15,7 @@
 
 uniform sampler3D uO@Bricks;  // homogeneousBricks (viewer/volume_analysis.h), nearest filtering
 #ifdef HAS_RECEIVER
-uniform sampler2D uO@Receiver;  // the receiver map of the ground (core/receiver_map.h), RGB W/m²
+uniform sampler2D uO@Receiver;  // the receiver map of the ground (core/receiver_map.h), RGB W/m² (RECEIVER_GREY: R alone)
 #endif
 
 // The light a reflection (or any branch the march does not follow) sees: the ground or the
@@ -108,7 +108,12 @@ bool receiverChange@(vec3 xw, out vec3 change) {
   covered = all(greaterThanEqual(st, vec2(0.0))) && all(lessThanEqual(st, vec2(1.0)));
   if (covered) {
     vec3 normal = cross(uObjRecvU[@], uObjRecvV[@]);
+#ifdef RECEIVER_GREY
+    vec2 g = texture(uO@Receiver, st).rg;  // a grey map: R = G = B, and the clearance
+    vec4 m = vec4(g.xxx, g.y);
+#else
     vec4 m = texture(uO@Receiver, st);
+#endif
     vec3 direct = lightIrradiance(uObjRecvLightPos[@], uObjRecvLightPower[@], uObjRecvLightSpot[@],
                                   uObjRecvLightSpotScale[@], x, normal);
     change = m.rgb - direct * (m.a >= 0.0 ? 1.0 : 2.0);

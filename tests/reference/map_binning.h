@@ -20,12 +20,13 @@ inline void binLikeMap(const ReceiverMap& map, Receiver& receiver) {
   receiver.map_origin = map.origin;
 }
 
-// The tally's map as planar irradiance (flux over texel area, every channel) in a copy of `map`.
+// The tally's map as planar irradiance (flux over texel area) on `map`'s lattice, grey.
 inline ReceiverMap irradianceLikeMap(const ReceiverMap& map, const ReceiverTally& tally) {
-  ReceiverMap exact = map;
+  ReceiverMap exact = map.geometry();
+  exact.components = 1;
+  exact.irradiance.resize(map.texelCount());
   for (std::size_t t = 0; t < map.texelCount(); ++t)
-    for (std::size_t c = 0; c < 3; ++c)
-      exact.irradiance[3 * t + c] = static_cast<float>(tally.map_flux[t] / (map.pitch * map.pitch));
+    exact.irradiance[t] = static_cast<float>(tally.map_flux[t] / (map.pitch * map.pitch));
   return exact;
 }
 
