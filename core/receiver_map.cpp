@@ -46,6 +46,14 @@ bool ReceiverMap::makeGrey() {
   return true;
 }
 
+void ReceiverMap::makeRgb() {
+  if (components == 3) return;
+  const std::size_t n = irradiance.size();
+  irradiance.resize(3 * n);
+  for (std::size_t t = n; t-- > 0;) irradiance[3 * t] = irradiance[3 * t + 1] = irradiance[3 * t + 2] = irradiance[t];
+  components = 3;
+}
+
 void receiverAxes(const glm::dvec3& normal, glm::dvec3& u, glm::dvec3& v) {
   const glm::dvec3 n = glm::normalize(normal);
   int axis = 0;

@@ -44,6 +44,16 @@ struct ReceiverMap {
   // An RGB map whose every texel holds three equal values becomes grey, in place (lossless);
   // any other map is left as it is. True when the map is grey afterwards.
   bool makeGrey();
+  // A grey map becomes RGB again (three equal values a texel), in place; an RGB map stays as it is.
+  void makeRgb();
+  // Every texel's RGB, whichever the layout (a copy: for comparisons of maps).
+  std::vector<float> rgbValues() const {
+    ReceiverMap copy;
+    copy.irradiance = irradiance;
+    copy.components = components;
+    copy.makeRgb();
+    return copy.irradiance;
+  }
   // World position of the centre of texel (i, j).
   glm::dvec3 texelCenter(int i, int j) const {
     return point + (origin.x + (i + 0.5) * pitch) * u + (origin.y + (j + 0.5) * pitch) * v;

@@ -679,7 +679,10 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
     // The sums start as zeros (12.6 MB at the 128³ sphere's 1024² texels), made on a thread of
     // their own while the initial patches are: filling fresh memory is mostly the kernel zeroing
     // its pages, which had held up this thread.
-    receiver_flux_made = std::async(std::launch::async, [&] { receiver_flux.emplace(receiver); });
+    // A grey light through a volume that absorbs nothing keeps every flux grey (Fresnel, splits and
+    // reflections scale all channels alike): its map is summed and made grey, a third of the memory.
+    const bool grey = light.power.x == light.power.y && light.power.y == light.power.z && !sampler_.hasAbsorption();
+    receiver_flux_made = std::async(std::launch::async, [&, grey] { receiver_flux.emplace(receiver, grey); });
   }
   double flux_ref = 0.0;
   DirectCells direct;  // cells that go straight to the receiver's map: in closed form, not followed
@@ -952,6 +955,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
     // Planar irradiance: each texel's flux over its area.
     receiver_flux->irradiance(direct_light ? &*direct_light : nullptr, 1.0 / (receiver.pitch * receiver.pitch),
                               receiver.irradiance);
+    receiver.components = receiver_flux->channels();
     bake.receivers.push_back(std::move(receiver));
   }
   stats.phase_seconds["update"] = t_update;

@@ -244,7 +244,7 @@ TEST(ExactOpticsSphere, FreeFlightBakesTheSameCausticInFewerSteps) {
   EXPECT_LT(flown.stats.total_patches, stepped.stats.total_patches / 3 * 2);
   // What changes: where a step ends, so where the patches split and meet the sphere. Measured
   // relative L2 4.0e-5 (map) and 3.8e-3 (field); 1 % would be a visible change of the caustic.
-  const double map = relativeL2(flown.map.irradiance, stepped.map.irradiance);
+  const double map = relativeL2(flown.map.rgbValues(), stepped.map.rgbValues());
   const double field = relativeL2(flown.irradiance.data, stepped.irradiance.data);
   std::printf("free flight against steps of Δt, 32³: map %.2e, field %.2e relative L2; %llu against %llu patch-steps\n", map,
               field, static_cast<unsigned long long>(flown.stats.total_patches),
@@ -773,7 +773,7 @@ TEST(ExactOpticsSceneChain, TheGpuPathHandsTheLightOnAsTheTwinDoes) {
   EXPECT_LT(worst, 0.08);
   EXPECT_GT(gl.lower.taken_in, 0u);
   EXPECT_EQ(gl.lower.left_out, cpu.lower.left_out);
-  const double l2 = relativeL2(gl.floor.irradiance, cpu.floor.irradiance);
+  const double l2 = relativeL2(gl.floor.rgbValues(), cpu.floor.rgbValues());
   std::printf("GL against the twin: relative L2 %.3g; taken in %zu against %zu\n", l2, gl.lower.taken_in,
               cpu.lower.taken_in);
   EXPECT_LT(l2, 0.01);
@@ -790,7 +790,7 @@ TEST(ExactOpticsSceneChain, AnObjectOfAirHandsTheSunOnUnchanged) {
   const StackedBake chained = bakeStackedSpheres(32, true, 1.0);
   const StackedBake alone = bakeStackedSpheres(32, false, 1.0);
   EXPECT_GT(chained.lower.taken_in, 0u);
-  const double l2 = relativeL2(chained.floor.irradiance, alone.floor.irradiance);
+  const double l2 = relativeL2(chained.floor.rgbValues(), alone.floor.rgbValues());
   std::printf("air above: relative L2 %.3g\n", l2);
   EXPECT_LT(l2, 0.01);
 }
@@ -806,7 +806,7 @@ TEST(ExactOpticsSphere, StraightStepsBakeTheSameCausticInFewerSteps) {
   const SphereBake flown = bakeSphereOnFloor(48, Stepping::Flight), straight = bakeSphereOnFloor(48, Stepping::Straight);
   EXPECT_TRUE(straight.irradiance.data.empty());  // the map only
   EXPECT_LT(straight.stats.total_patches, flown.stats.total_patches / 3 * 2);
-  const double map = relativeL2(straight.map.irradiance, flown.map.irradiance);
+  const double map = relativeL2(straight.map.rgbValues(), flown.map.rgbValues());
   std::printf("straight steps against steps of Δt, 48³: map %.2e relative L2; %llu against %llu patch-steps\n", map,
               static_cast<unsigned long long>(straight.stats.total_patches),
               static_cast<unsigned long long>(flown.stats.total_patches));
@@ -858,7 +858,7 @@ TEST(ExactOpticsSphere, TheGpuPathFliesAndTakesStraightStepsAsTheTwinDoes) {
   // Float against double corners: where a patch splits or a flight ends moves by rounding, so the
   // two bakes are not the same patch for patch. Measured at 48³: 1.6e-3 relative L2, 153 947
   // against 154 608 patch-steps; 2 % more patch-steps would be a flight or straight step refused.
-  const double map = relativeL2(gpu.map.irradiance, cpu.map.irradiance);
+  const double map = relativeL2(gpu.map.rgbValues(), cpu.map.rgbValues());
   std::printf("GPU path against the twin, 48³: map %.2e relative L2; %llu against %llu patch-steps\n", map,
               static_cast<unsigned long long>(gpu.stats.total_patches),
               static_cast<unsigned long long>(cpu.stats.total_patches));

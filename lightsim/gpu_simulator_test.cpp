@@ -209,7 +209,7 @@ TEST(GpuSimulatorTest, SharpSphereOverAFloorWithTrackDepositsAndReceiverMatchesC
   const ReceiverMap& g = c.gpu.receivers[0];
   const ReceiverMap& m = c.cpu.receivers[0];
   ASSERT_EQ(g.texels, m.texels);
-  const double e = relativeL2(g.irradiance, m.irradiance);
+  const double e = relativeL2(g.rgbValues(), m.rgbValues());
   std::printf("receiver map %d x %d: relative L2 %.2e\n", m.texels.x, m.texels.y, e);
   EXPECT_LT(e, 0.01);
   const double in = luminance(c.cpu.stats.flux_in);
@@ -327,7 +327,7 @@ TEST(GpuSimulatorTest, WithVolumeDepositsTheGpuPathFliesAsFarAsItsTrackDepositsR
   exact.exact_sampling = true;
   const Comparison c = compare(volume, light, flying, exact);
   expectBakesAgree(c);
-  const double map = relativeL2(c.gpu.receivers.at(0).irradiance, c.cpu.receivers.at(0).irradiance);
+  const double map = relativeL2(c.gpu.receivers.at(0).rgbValues(), c.cpu.receivers.at(0).rgbValues());
   std::printf("receiver map: relative L2 %.2e\n", map);
   EXPECT_LT(map, 0.01);
   GpuSimulator gpu(volume, exact);
@@ -402,7 +402,7 @@ TEST(GpuSimulatorTest, TheDirectLightOnTheMapBakesTheMapThePatchesGoingStraightT
     SCOPED_TRACE(d.stats.backend);
     ASSERT_EQ(d.receivers.size(), 1u);
     ASSERT_EQ(p.receivers.size(), 1u);
-    const double e = relativeL2(d.receivers[0].irradiance, p.receivers[0].irradiance);
+    const double e = relativeL2(d.receivers[0].rgbValues(), p.receivers[0].rgbValues());
     std::printf("%s: map relative L2 %.2e; initial patches %llu against %llu, patch-steps %llu against %llu\n",
                 d.stats.backend.c_str(), e, static_cast<unsigned long long>(d.stats.initial_patches),
                 static_cast<unsigned long long>(p.stats.initial_patches),

@@ -255,7 +255,7 @@ int DirectMapLight::heldBands() const {
   return static_cast<int>(std::count_if(followed_.begin(), followed_.end(), [](const auto& b) { return !b.empty(); }));
 }
 
-FootprintSums::FootprintSums(const ReceiverMap& map) : map_(map) {
+FootprintSums::FootprintSums(const ReceiverMap& map, bool grey) : map_(map), channels_(grey ? 1 : 3) {
   map_.irradiance.clear();
   for (int k = 1; k <= kFootprintLevels; ++k) {
     ReceiverMap level = map_;
@@ -263,7 +263,7 @@ FootprintSums::FootprintSums(const ReceiverMap& map) : map_(map) {
     level.texels = (map.texels + glm::ivec2((1 << k) - 1)) / (1 << k);
     coarse_.push_back(std::move(level));
   }
-  fine_.assign(3 * map_.texelCount(), 0.0f);
+  fine_.assign(static_cast<std::size_t>(channels_) * map_.texelCount(), 0.0f);
   bands_.assign(kFootprintLevels + 1, std::vector<std::vector<glm::dvec3>>(static_cast<std::size_t>(bands())));
 }
 
@@ -285,7 +285,8 @@ void FootprintSums::deposit(const std::array<glm::dvec2, 4>& footprint, const gl
   const ReceiverMap& level_map = k == 0 ? map_ : coarse_[static_cast<std::size_t>(k - 1)];
   const int first = band * rows;
   if (k == 0) {
-    depositFootprint(map_, footprint, flux, TexelRows{nullptr, map_.texels.x, 0, first, first + rows, fine_.data()});
+    depositFootprint(map_, footprint, flux,
+                     TexelRows{nullptr, map_.texels.x, 0, first, first + rows, fine_.data(), channels_});
     return;
   }
   std::vector<glm::dvec3>& block = bands_[static_cast<std::size_t>(k)][static_cast<std::size_t>(band)];
@@ -296,7 +297,8 @@ void FootprintSums::deposit(const std::array<glm::dvec2, 4>& footprint, const gl
 FootprintSums::RowSums FootprintSums::rowSums(int j) const {
   const int band = j / kBandRows;
   RowSums r;
-  r.fine = fine_.data() + 3 * static_cast<std::size_t>(j) * static_cast<std::size_t>(map_.texels.x);
+  r.fine = fine_.data() + static_cast<std::size_t>(channels_) * static_cast<std::size_t>(j) * static_cast<std::size_t>(map_.texels.x);
+  r.channels = channels_;
   for (int k = 1; k <= kFootprintLevels; ++k) {
     // A band of the map is a whole band of every level (kBandRows is a multiple of 2^k).
     const std::vector<glm::dvec3>& block = bands_[static_cast<std::size_t>(k)][static_cast<std::size_t>(band)];
@@ -311,8 +313,8 @@ FootprintSums::RowSums FootprintSums::rowSums(int j) const {
 glm::dvec3 FootprintSums::RowSums::flux(int i) const {
   // The texel's own flux, then each coarser level's share over it, k = 1, 2, ... in order (the same
   // sums whatever the thread count).
-  const float* texel = fine + 3 * static_cast<std::size_t>(i);
-  glm::dvec3 f(texel[0], texel[1], texel[2]);
+  const float* texel = fine + static_cast<std::size_t>(channels) * static_cast<std::size_t>(i);
+  glm::dvec3 f = channels == 1 ? glm::dvec3(texel[0]) : glm::dvec3(texel[0], texel[1], texel[2]);
   for (int k = 1; k <= kFootprintLevels; ++k)
     if (level[k]) f += level[k][i >> k] * (1.0 / static_cast<double>(1 << (2 * k)));
   return f;
@@ -338,11 +340,13 @@ void FootprintSums::irradiance(const DirectMapLight* extra, double inv_area, std
       [&](std::int64_t j64) {
         const int j = static_cast<int>(j64);
         const RowSums sums = rowSums(j);
-        float* row = fine_.data() + 3 * static_cast<std::size_t>(j) * static_cast<std::size_t>(map_.texels.x);
+        const std::size_t channels = static_cast<std::size_t>(channels_);
+        float* row = fine_.data() + channels * static_cast<std::size_t>(j) * static_cast<std::size_t>(map_.texels.x);
         for (int i = 0; i < map_.texels.x; ++i) {
           glm::dvec3 flux = sums.flux(i);  // (texel i's sums read before they are written over)
           if (extra) flux += extra->flux(i, j);
-          for (int c = 0; c < 3; ++c) row[3 * i + c] = static_cast<float>(flux[c] * inv_area);
+          for (std::size_t c = 0; c < channels; ++c)
+            row[channels * static_cast<std::size_t>(i) + c] = static_cast<float>(flux[static_cast<int>(c)] * inv_area);
         }
       },
       16);

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <array>
+#include <cassert>
 #include <limits>
 #include <string>
 #include <vector>
@@ -65,9 +66,13 @@ struct TexelRows {
   int row_begin = 0;
   int row_end = 0;
   float* rgb = nullptr;
+  int channels = 3;  // of `rgb`: 3, or 1 for a grey map (every flux's channels equal: the first)
   void add(int j, int i, const glm::dvec3& flux) const {
     const std::size_t t = static_cast<std::size_t>(j - first_row) * static_cast<std::size_t>(width) + static_cast<std::size_t>(i);
-    if (rgb) {
+    if (rgb && channels == 1) {
+      assert(flux.x == flux.y && flux.y == flux.z);  // FootprintSums(map, grey): only grey flux
+      rgb[t] += static_cast<float>(flux.x);
+    } else if (rgb) {
       float* texel = rgb + 3 * t;
       for (int c = 0; c < 3; ++c) texel[c] += static_cast<float>(flux[c]);
     } else {
@@ -140,7 +145,11 @@ class FootprintSums {
   // map is a whole band of every level).
   static constexpr int kBandRows = 16;
 
-  explicit FootprintSums(const ReceiverMap& map);
+  // `grey`: every flux deposited has three equal channels (a grey light, nothing that colours it),
+  // and the fine level keeps one float a texel (a third of the memory, 12.6 → 4.2 MB at 1024²);
+  // irradiance() then gives a grey map (ReceiverMap::components 1).
+  explicit FootprintSums(const ReceiverMap& map, bool grey = false);
+  int channels() const { return channels_; }
   // The level a footprint goes to.
   int level(const std::array<glm::dvec2, 4>& footprint) const;
   // depositFootprint into its level, for the map rows of band `band` only.
@@ -148,7 +157,7 @@ class FootprintSums {
   int bands() const { return (map_.texels.y + kBandRows - 1) / kBandRows; }
   // Each map texel's flux (W): its own plus its share of every coarser level's texel over it.
   std::vector<glm::dvec3> resolve() const;
-  // The map's irradiance (3 floats a texel): each texel's flux as resolve() gives it, plus
+  // The map's irradiance (channels() floats a texel): each texel's flux as resolve() gives it, plus
   // `extra`'s (directMapLight's; none: nothing), times inv_area, written over the fine level's sums,
   // whose storage `out` then takes (the map's irradiance is the only copy: no second 12 MB at
   // 1024²). The sums are spent: nothing may be deposited or resolved after.
@@ -157,7 +166,8 @@ class FootprintSums {
  private:
   // Row j's sums on every level (null where the band holds none), and texel i's flux from them.
   struct RowSums {
-    const float* fine = nullptr;  // level 0: RGB floats
+    const float* fine = nullptr;  // level 0: RGB floats, or grey ones (channels 1)
+    int channels = 3;
     const glm::dvec3* level[kFootprintLevels + 1] = {};  // levels ≥ 1
     glm::dvec3 flux(int i) const;
   };
@@ -169,6 +179,7 @@ class FootprintSums {
   // In doubles by bands it took 19 MB of fresh memory on the 128³ sphere's 1024² map besides the
   // 12 MB output; float sums differ from those by rounding (about 1e-7 of a texel's flux).
   std::vector<float> fine_;
+  int channels_ = 3;
   // Level k ≥ 1's per-texel flux by bands of kBandRows >> k rows (band b: its rows from
   // b·(kBandRows >> k)), each band's made at the first footprint that lands in it.
   std::vector<std::vector<std::vector<glm::dvec3>>> bands_;

@@ -205,6 +205,34 @@ TEST(Receiver, WideFootprintsGoToCoarseLevelsAndKeepTheirFluxAndDensity) {
     }
 }
 
+// Grey sums (a grey light through a volume that colours nothing): one float a texel, the same
+// values as the first channel of RGB sums of the same footprints, fine and coarse, to the bit.
+TEST(Receiver, GreySumsAreTheFirstChannelOfRgbSums) {
+  const ReceiverMap map = unitMap(100, 0.01);
+  const std::array<glm::dvec2, 4> small{{{-0.031, -0.052}, {0.071, -0.04}, {0.063, 0.061}, {-0.04, 0.05}}};
+  const std::array<glm::dvec2, 4> wide{{{-0.43, -0.12}, {0.38, -0.25}, {0.41, -0.07}, {-0.45, 0.11}}};
+  FootprintSums rgb(map), grey(map, true);
+  EXPECT_EQ(rgb.channels(), 3);
+  EXPECT_EQ(grey.channels(), 1);
+  for (int band = 0; band < rgb.bands(); ++band) {
+    for (FootprintSums* sums : {&rgb, &grey}) {
+      sums->deposit(small, glm::dvec3(0.7), band);
+      sums->deposit(wide, glm::dvec3(0.3), band);
+    }
+  }
+  std::vector<float> e_rgb, e_grey;
+  rgb.irradiance(nullptr, 1e4, e_rgb);
+  grey.irradiance(nullptr, 1e4, e_grey);
+  ASSERT_EQ(e_rgb.size(), 3 * map.texelCount());
+  ASSERT_EQ(e_grey.size(), map.texelCount());
+  std::size_t lit = 0;
+  for (std::size_t t = 0; t < map.texelCount(); ++t) {
+    ASSERT_EQ(e_grey[t], e_rgb[3 * t]) << t;
+    lit += e_grey[t] > 0.0f;
+  }
+  EXPECT_GT(lit, map.texelCount() / 10);  // the wide footprint covers a fifth of the map
+}
+
 // The direct light on the map (directMapLight) against the patches it stands for: a sun at 40°
 // over a small glass sphere's box, its map on the floor below. Every cell of the light's lattice
 // that meets the box or the map, each going straight to the floor as a patch (initialPatches

@@ -375,6 +375,7 @@ SceneLightChain::Exchange& SceneLightChain::Exchange::operator+=(const Exchange&
 void SceneLightChain::correctMap(std::size_t k, BakeResult& result) {
   if (!result.receivers.empty()) {
     ReceiverMap& map = result.receivers.front();
+    map.makeRgb();  // the corrections may be coloured (applyBake makes it grey again where it stays so)
     std::vector<glm::dvec3> flux(map.texelCount(), glm::dvec3(0.0));
     std::array<glm::dvec2, 4> footprint;
     for (const Patch& p : left_out_[k])

@@ -188,9 +188,9 @@ double relativeL2InCells(const ReceiverMap& map, const ReceiverMap& reference, i
         double a = 0.0, b = 0.0;
         for (int j = J; j < J + bin; ++j)
           for (int i = I; i < I + bin; ++i) {
-            const std::size_t t = 3 * (static_cast<std::size_t>(j) * reference.texels.x + i) + c;
-            a += map.irradiance.at(t);
-            b += reference.irradiance.at(t);
+            const std::size_t t = static_cast<std::size_t>(j) * reference.texels.x + i;
+            a += map.rgb(t)[c];
+            b += reference.rgb(t)[c];
           }
         diff += (a - b) * (a - b);
         norm += b * b;

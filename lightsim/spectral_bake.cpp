@@ -72,6 +72,11 @@ void BandSum::add(BakeResult band) {
   }
   for (std::size_t i = 0; i < band.irradiance.data.size(); ++i) sum_.irradiance.data[i] += band.irradiance.data[i];
   for (std::size_t r = 0; r < band.receivers.size(); ++r) {
+    // A grey map and an RGB one (a white light and a coloured one) sum as RGB.
+    if (band.receivers[r].components != sum_.receivers[r].components) {
+      band.receivers[r].makeRgb();
+      sum_.receivers[r].makeRgb();
+    }
     std::vector<float>& to = sum_.receivers[r].irradiance;
     const std::vector<float>& from = band.receivers[r].irradiance;
     if (from.size() != to.size()) throw std::logic_error("BandSum: receiver maps of different sizes");

@@ -21,6 +21,15 @@ void makeSphere(const TempDir& dir) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
 }
 
+// A clear glass ball of radius 0.4, 24³, with room below it for a ground at y = −0.8.
+void makeGlassBall(const TempDir& dir) {
+  ProgramResult r = runProgram(VOXELIZE_EXE,
+                               {"procedural:sphere,r=0.4,ior=1.5", "-o", "glass.vol.json", "--res", "24",
+                                "--bounds", "-1,-0.9,-1,1,1.1,1", "--quiet"},
+                               dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+}
+
 TEST(ViewerCli, RendersBeerLambertThroughTheCentre) {
   TempDir dir;
   makeSphere(dir);
@@ -186,11 +195,8 @@ TEST(ViewerCli, A1024CubedVolumeInTinyFilesIsRefusedBeforeItsMemory) {
 // plane, the procedural sky; the flags that switch terms off run too.
 TEST(ViewerCli, RendersABakedSceneWithGroundSkyAndTwoObjects) {
   TempDir dir;
-  ProgramResult r = runProgram(VOXELIZE_EXE,
-                               {"procedural:sphere,r=0.4,ior=1.5", "-o", "glass.vol.json", "--res", "24",
-                                "--bounds", "-1,-0.9,-1,1,1.1,1", "--quiet"},
-                               dir.path());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
+  makeGlassBall(dir);
+  ProgramResult r;
   r = runProgram(LIGHTSIM_EXE,
                  {"glass.vol.json", "-o", "baked.vol.json", "--light", "directional:0,-1,0", "--backend", "cpu", "--quiet"},
                  dir.path());
@@ -252,11 +258,8 @@ TEST(ViewerCli, RendersABakedSceneWithGroundSkyAndTwoObjects) {
 // keeps its map RGB.
 TEST(ViewerCli, AGreyReceiverMapRendersAsItsRgbTwin) {
   TempDir dir;
-  ProgramResult r = runProgram(VOXELIZE_EXE,
-                               {"procedural:sphere,r=0.4,ior=1.5", "-o", "glass.vol.json", "--res", "24",
-                                "--bounds", "-1,-0.9,-1,1,1.1,1", "--quiet"},
-                               dir.path());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
+  makeGlassBall(dir);
+  ProgramResult r;
   for (const char* power : {"1,1,1", "1,0.5,0.25"}) {
     r = runProgram(LIGHTSIM_EXE,
                    {"glass.vol.json", "-o", std::string(power) == "1,1,1" ? "grey.vol.json" : "coloured.vol.json",
