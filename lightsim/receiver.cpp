@@ -222,20 +222,36 @@ DirectMapLight directMapLight(const ReceiverMap& map, const LightSpec& light, co
   constexpr int kRows = DirectMapLight::kRows;
   static_assert(kRows == FootprintSums::kBandRows);
   const int bands = (map.texels.y + kRows - 1) / kRows;
-  direct.followed_.resize(static_cast<std::size_t>(bands));
+  direct.grey_ = light.power.x == light.power.y && light.power.y == light.power.z;
+  for (const Patch& p : followed) direct.grey_ = direct.grey_ && p.flux.x == p.flux.y && p.flux.y == p.flux.z;
+  if (direct.grey_)
+    direct.followed_grey_.resize(static_cast<std::size_t>(bands));
+  else
+    direct.followed_.resize(static_cast<std::size_t>(bands));
+  const std::size_t band_texels = static_cast<std::size_t>(kRows) * static_cast<std::size_t>(map.texels.x);
   parallelFor(0, bands, [&](std::int64_t band) {
     const int r0 = static_cast<int>(band) * kRows, r1 = r0 + kRows;
     const double y0 = map.origin.y + r0 * map.pitch, y1 = map.origin.y + r1 * map.pitch;
-    std::vector<glm::dvec3>& sums = direct.followed_[static_cast<std::size_t>(band)];
+    TexelRows rows{nullptr, map.texels.x, r0, r0, std::min(r1, map.texels.y)};
     for (std::size_t k = 0; k < count; ++k) {
       if (!lands[k]) continue;
       const std::array<glm::dvec2, 4>& f = footprints[k];
       const double lo = std::min(std::min(f[0].y, f[1].y), std::min(f[2].y, f[3].y));
       const double hi = std::max(std::max(f[0].y, f[1].y), std::max(f[2].y, f[3].y));
       if (hi < y0 || lo > y1) continue;
-      if (sums.empty()) sums.assign(static_cast<std::size_t>(kRows) * static_cast<std::size_t>(map.texels.x), glm::dvec3(0.0));
-      depositFootprint(map, f, followed[k].flux,
-                       TexelRows{sums.data(), map.texels.x, r0, r0, std::min(r1, map.texels.y)});
+      if (!rows.data && !rows.grey) {  // the band's sums, made at its first footprint
+        if (direct.grey_) {
+          std::vector<double>& sums = direct.followed_grey_[static_cast<std::size_t>(band)];
+          sums.assign(band_texels, 0.0);
+          rows.grey = sums.data();
+          rows.channels = 1;
+        } else {
+          std::vector<glm::dvec3>& sums = direct.followed_[static_cast<std::size_t>(band)];
+          sums.assign(band_texels, glm::dvec3(0.0));
+          rows.data = sums.data();
+        }
+      }
+      depositFootprint(map, f, followed[k].flux, rows);
     }
   });
   return direct;
@@ -252,6 +268,9 @@ std::vector<glm::dvec3> DirectMapLight::texels() const {
 }
 
 int DirectMapLight::heldBands() const {
+  if (grey_)
+    return static_cast<int>(
+        std::count_if(followed_grey_.begin(), followed_grey_.end(), [](const auto& b) { return !b.empty(); }));
   return static_cast<int>(std::count_if(followed_.begin(), followed_.end(), [](const auto& b) { return !b.empty(); }));
 }
 
@@ -264,7 +283,10 @@ FootprintSums::FootprintSums(const ReceiverMap& map, bool grey) : map_(map), cha
     coarse_.push_back(std::move(level));
   }
   fine_.assign(static_cast<std::size_t>(channels_) * map_.texelCount(), 0.0f);
-  bands_.assign(kFootprintLevels + 1, std::vector<std::vector<glm::dvec3>>(static_cast<std::size_t>(bands())));
+  if (grey)
+    grey_bands_.assign(kFootprintLevels + 1, std::vector<std::vector<double>>(static_cast<std::size_t>(bands())));
+  else
+    bands_.assign(kFootprintLevels + 1, std::vector<std::vector<glm::dvec3>>(static_cast<std::size_t>(bands())));
 }
 
 int FootprintSums::level(const std::array<glm::dvec2, 4>& f) const {
@@ -289,8 +311,16 @@ void FootprintSums::deposit(const std::array<glm::dvec2, 4>& footprint, const gl
                      TexelRows{nullptr, map_.texels.x, 0, first, first + rows, fine_.data(), channels_});
     return;
   }
+  const std::size_t texels = static_cast<std::size_t>(rows) * static_cast<std::size_t>(level_map.texels.x);
+  if (channels_ == 1) {
+    std::vector<double>& block = grey_bands_[static_cast<std::size_t>(k)][static_cast<std::size_t>(band)];
+    if (block.empty()) block.assign(texels, 0.0);
+    depositFootprint(level_map, footprint, flux,
+                     TexelRows{nullptr, level_map.texels.x, first, first, first + rows, nullptr, 1, block.data()});
+    return;
+  }
   std::vector<glm::dvec3>& block = bands_[static_cast<std::size_t>(k)][static_cast<std::size_t>(band)];
-  if (block.empty()) block.assign(static_cast<std::size_t>(rows) * static_cast<std::size_t>(level_map.texels.x), glm::dvec3(0.0));
+  if (block.empty()) block.assign(texels, glm::dvec3(0.0));
   depositFootprint(level_map, footprint, flux, TexelRows{block.data(), level_map.texels.x, first, first, first + rows});
 }
 
@@ -301,11 +331,17 @@ FootprintSums::RowSums FootprintSums::rowSums(int j) const {
   r.channels = channels_;
   for (int k = 1; k <= kFootprintLevels; ++k) {
     // A band of the map is a whole band of every level (kBandRows is a multiple of 2^k).
+    const int rows = kBandRows >> k;
+    const std::size_t offset = static_cast<std::size_t>((j >> k) - band * rows) *
+                               static_cast<std::size_t>(coarse_[static_cast<std::size_t>(k - 1)].texels.x);
+    if (channels_ == 1) {
+      const std::vector<double>& block = grey_bands_[static_cast<std::size_t>(k)][static_cast<std::size_t>(band)];
+      if (!block.empty()) r.grey_level[k] = block.data() + offset;  // (empty: its sums are 0 there)
+      continue;
+    }
     const std::vector<glm::dvec3>& block = bands_[static_cast<std::size_t>(k)][static_cast<std::size_t>(band)];
     if (block.empty()) continue;  // its sums are 0 there
-    const int rows = kBandRows >> k;
-    r.level[k] = block.data() + static_cast<std::size_t>((j >> k) - band * rows) *
-                                    static_cast<std::size_t>(coarse_[static_cast<std::size_t>(k - 1)].texels.x);
+    r.level[k] = block.data() + offset;
   }
   return r;
 }
@@ -317,6 +353,7 @@ glm::dvec3 FootprintSums::RowSums::flux(int i) const {
   glm::dvec3 f = channels == 1 ? glm::dvec3(texel[0]) : glm::dvec3(texel[0], texel[1], texel[2]);
   for (int k = 1; k <= kFootprintLevels; ++k)
     if (level[k]) f += level[k][i >> k] * (1.0 / static_cast<double>(1 << (2 * k)));
+    else if (grey_level[k]) f += glm::dvec3(grey_level[k][i >> k] * (1.0 / static_cast<double>(1 << (2 * k))));
   return f;
 }
 

@@ -66,11 +66,14 @@ struct TexelRows {
   int row_begin = 0;
   int row_end = 0;
   float* rgb = nullptr;
-  int channels = 3;  // of `rgb`: 3, or 1 for a grey map (every flux's channels equal: the first)
+  int channels = 3;  // of `rgb` or `grey`: 3, or 1 for a grey map (every flux's channels equal: the first)
+  double* grey = nullptr;  // one double a texel (channels 1), instead of `data`
   void add(int j, int i, const glm::dvec3& flux) const {
     const std::size_t t = static_cast<std::size_t>(j - first_row) * static_cast<std::size_t>(width) + static_cast<std::size_t>(i);
-    if (rgb && channels == 1) {
-      assert(flux.x == flux.y && flux.y == flux.z);  // FootprintSums(map, grey): only grey flux
+    assert(channels == 3 || (flux.x == flux.y && flux.y == flux.z));  // FootprintSums(map, grey): only grey flux
+    if (grey) {
+      grey[t] += flux.x;
+    } else if (rgb && channels == 1) {
       rgb[t] += static_cast<float>(flux.x);
     } else if (rgb) {
       float* texel = rgb + 3 * t;
@@ -99,11 +102,15 @@ class DirectMapLight {
   // W on texel (i, j).
   glm::dvec3 flux(int i, int j) const {
     const glm::dvec3 full = closedForm(i, j);
+    const std::size_t t =
+        static_cast<std::size_t>(j % kRows) * static_cast<std::size_t>(map_.texels.x) + static_cast<std::size_t>(i);
+    if (grey_) {
+      const std::vector<double>& band = followed_grey_[static_cast<std::size_t>(j / kRows)];
+      return band.empty() ? full : glm::max(full - glm::dvec3(band[t]), glm::dvec3(0.0));
+    }
     const std::vector<glm::dvec3>& band = followed_[static_cast<std::size_t>(j / kRows)];
     if (band.empty()) return full;
-    return glm::max(full - band[static_cast<std::size_t>(j % kRows) * static_cast<std::size_t>(map_.texels.x) +
-                                static_cast<std::size_t>(i)],
-                    glm::dvec3(0.0));
+    return glm::max(full - band[t], glm::dvec3(0.0));
   }
   // Every texel's, u fastest (the GPU path's receiver pass).
   std::vector<glm::dvec3> texels() const;
@@ -125,6 +132,9 @@ class DirectMapLight {
   LightSpec light_;
   glm::dvec3 full_{0.0};
   std::vector<std::vector<glm::dvec3>> followed_;  // per band: the followed patches' straight flux, or none
+  // …or, for a grey light (every patch's flux grey), one double a texel: a third of the memory.
+  bool grey_ = false;
+  std::vector<std::vector<double>> followed_grey_;
 };
 DirectMapLight directMapLight(const ReceiverMap& map, const LightSpec& light, const std::vector<Patch>& followed);
 
@@ -168,7 +178,8 @@ class FootprintSums {
   struct RowSums {
     const float* fine = nullptr;  // level 0: RGB floats, or grey ones (channels 1)
     int channels = 3;
-    const glm::dvec3* level[kFootprintLevels + 1] = {};  // levels ≥ 1
+    const glm::dvec3* level[kFootprintLevels + 1] = {};  // levels ≥ 1 (RGB)
+    const double* grey_level[kFootprintLevels + 1] = {};  // …or grey (channels 1)
     glm::dvec3 flux(int i) const;
   };
   RowSums rowSums(int j) const;
@@ -183,6 +194,7 @@ class FootprintSums {
   // Level k ≥ 1's per-texel flux by bands of kBandRows >> k rows (band b: its rows from
   // b·(kBandRows >> k)), each band's made at the first footprint that lands in it.
   std::vector<std::vector<std::vector<glm::dvec3>>> bands_;
+  std::vector<std::vector<std::vector<double>>> grey_bands_;  // the same for grey sums (channels 1)
 };
 
 // Area of the intersection of triangle (a, b, c) with the axis-aligned square [lo, hi] (exact,
