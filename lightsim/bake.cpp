@@ -88,6 +88,7 @@ nlohmann::json SimulationStats::toJson() const {
   j["reflections"] = reflections;
   j["rollbacks"] = rollbacks;
   j["flights"] = flights;
+  if (!patch_steps_by_bounce.empty()) j["patch_steps_by_bounce"] = patch_steps_by_bounce;
   // The energy ledger: flux_in = out + absorbed + reflected + killed + unfinished + received +
   // blocked (W, RGB).
   j["flux"] = {{"in", vec3Json(flux_in)},

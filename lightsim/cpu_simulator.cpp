@@ -774,6 +774,9 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
     for (std::size_t i = 0; i < count; ++i) {
       const PatchStepResult& r = results[i];
       const Patch& p = patches[i];
+      const std::size_t bounce = static_cast<std::size_t>(std::max(p.bounce, 0));
+      if (bounce >= stats.patch_steps_by_bounce.size()) stats.patch_steps_by_bounce.resize(bounce + 1, 0);
+      ++stats.patch_steps_by_bounce[bounce];
       stats.flux_absorbed += r.absorbed;
       stats.flux_reflected += r.reflected;
       if (r.rolled_back) ++stats.rollbacks;

@@ -1058,5 +1058,45 @@ TEST(CpuSimulator, MergedStraightStepsBakeTheSameLightInFewerPatchSteps) {
     EXPECT_LT(ledgerResidual(merged.stats), 1e-9);
   }
 }
+
+// The patch-steps by the reflections their light came through (SimulationStats::
+// patch_steps_by_bounce, `lightsim --stats`): they add up to the patch-steps; with --bounces B
+// there are B + 1 orders; and each order's count does not depend on how many orders after it are
+// followed (a reflected wavefront is a patch of its own: the light it left goes on as it did), so
+// a wrong index — a reflection counted with its parent, or at its parent's order — fails here.
+TEST(CpuSimulator, PatchStepsAreCountedByTheReflectionsTheirLightCameThrough) {
+  const Volume volume = sharpVolume("procedural:sphere,r=1,center=0:1.5:0,ior=1.5", 32, std::nullopt, 2.0);
+  CpuSimulator sim(volume);
+  LightSpec light;
+  light.direction = glm::dvec3(0.0, -1.0, 0.0);
+  SimulationOptions options;
+  const VolumeDefaults defaults = volumeDefaults(true, volume.grid);
+  options.max_depth = defaults.max_depth;
+  options.patch_voxels = defaults.patch_voxels;
+  options.split_voxels = defaults.split_voxels;
+  options.free_flight = true;
+  options.volume_deposits = false;
+  options.straight_step_voxels = 2.0;
+  ReceiverSpec floor;
+  floor.half_extent = 2.0;
+  options.receiver = floor;
+  std::vector<std::vector<std::uint64_t>> counts;
+  for (int bounces = 0; bounces <= 2; ++bounces) {
+    SCOPED_TRACE(bounces);
+    options.bounces = bounces;
+    const BakeResult bake = sim.run(light, options);
+    const std::vector<std::uint64_t>& by_bounce = bake.stats.patch_steps_by_bounce;
+    ASSERT_EQ(by_bounce.size(), static_cast<std::size_t>(bounces + 1));
+    std::uint64_t sum = 0;
+    for (const std::uint64_t n : by_bounce) {
+      EXPECT_GT(n, 0u);
+      sum += n;
+    }
+    EXPECT_EQ(sum, bake.stats.total_patches);
+    EXPECT_EQ(bake.stats.toJson().at("patch_steps_by_bounce").get<std::vector<std::uint64_t>>(), by_bounce);
+    for (std::size_t b = 0; b < counts.size(); ++b) EXPECT_EQ(by_bounce[b], counts.back()[b]) << "order " << b;
+    counts.push_back(by_bounce);
+  }
+}
 }  // namespace
 }  // namespace eik

@@ -13,6 +13,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
@@ -203,6 +204,10 @@ struct SimulationStats {
   std::uint64_t reflections = 0;     // reflected wavefronts followed (bounces)
   std::uint64_t rollbacks = 0;       // steps undone to split a patch torn by an interface
   std::uint64_t flights = 0;         // patch-steps taken as free flights (longer than Δt)
+  // CPU twin: the patch-steps of the wavefronts reflected b times, at index b (index 0: the light
+  // that has not been reflected); they sum to total_patches. What each order of --bounces costs.
+  // Empty from the GPU path.
+  std::vector<std::uint64_t> patch_steps_by_bounce;
   std::map<std::string, double> phase_seconds;   // "init", "update", "analysis", "compact", "deposit", "readback", ...
   // |flux_in − (out + absorbed + reflected + killed + unfinished + received + blocked)| over the
   // largest channel of flux_in, worst channel: 0 for an exact ledger.

@@ -88,6 +88,9 @@ void BandSum::add(BakeResult band) {
   s.initial_patches += b.initial_patches;
   s.peak_patches = std::max(s.peak_patches, b.peak_patches);
   s.total_patches += b.total_patches;
+  if (s.patch_steps_by_bounce.size() < b.patch_steps_by_bounce.size())
+    s.patch_steps_by_bounce.resize(b.patch_steps_by_bounce.size(), 0);
+  for (std::size_t i = 0; i < b.patch_steps_by_bounce.size(); ++i) s.patch_steps_by_bounce[i] += b.patch_steps_by_bounce[i];
   s.splits += b.splits;
   s.kills.flux += b.kills.flux;
   s.kills.exited += b.kills.exited;

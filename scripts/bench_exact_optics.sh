@@ -22,7 +22,7 @@
 #
 # Usage: scripts/bench_exact_optics.sh [--out DIR] [--quick] [--build DIR] [--res "N..."]
 #                                      [--backend auto|gl|cpu] [--no-pov] [--pov-counts "N..."]
-#                                      [--exact FILE]
+#                                      [--exact FILE] [--bounces B] [--rounds R]
 #   --out DIR      outputs (volumes, images, JSON, logs, table.md); default BUILD/bench-exact-optics
 #   --quick        N = 32 and 64, 10⁶ tracer rays, one POV-Ray photon count, one run each (a test)
 #   --build DIR    the build tree with voxelize, lightsim, viewer and tests/ring_compare (default build)
@@ -33,6 +33,9 @@
 #   --pov-counts "N..."  POV-Ray's photon counts (default "100000 200000 400000 1600000"), e.g. to
 #                  find the fewest photons at a given error
 #   --exact FILE   the exact tracer's JSON of an earlier run instead of tracing again
+#   --bounces B    lightsim's --bounces for every bake (default: lightsim's, one). On the sphere the
+#                  light reflected three times inside it lands in the rings 0.4–0.9: with 3 the
+#                  floor's error falls below POV-Ray's at 150 k photons (BENCHMARKS.md, thirty-first part)
 #   --rounds R     then R rounds, alternated, of the whole pipeline (voxelize + bake + render at the
 #                  first --res) and POV-Ray at the first photon count, one after the other in each
 #                  round: both feel the machine's load alike. Prints their medians, the ratio of the
@@ -44,7 +47,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build="$root/build"
 out=""
-quick=0 res_option="" backend=auto pov=1 exact_file="" pov_option="" rounds=0
+quick=0 res_option="" backend=auto pov=1 exact_file="" pov_option="" rounds=0 bounces=() bounce_label=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --out) out=$2; shift 2 ;;
@@ -56,6 +59,7 @@ while [ $# -gt 0 ]; do
     --pov-counts) pov_option=$2; shift 2 ;;
     --exact) exact_file=$(cd "$(dirname "$2")" && pwd)/$(basename "$2"); shift 2 ;;
     --rounds) rounds=$2; shift 2 ;;
+    --bounces) bounces=(--bounces "$2") bounce_label=" --bounces $2"; shift 2 ;;
     -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
     *) echo "bench_exact_optics.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
   esac
@@ -150,14 +154,14 @@ eikonal() {  # $1 resolution, $2 sharp|smooth
     --pad 2 --interfaces "$mode")
   log "Eikonal $res³ $mode: bake ($repeats×)"
   bake=$(timed "$lightsim" "$out/$name.vol.json" -o "$out/$name.baked.vol.json" --scene "$out/bake_scene.json" \
-    --backend "$backend" --stats "$out/$name.bake_stats.json")
+    --backend "$backend" --stats "$out/$name.bake_stats.json" ${bounces[@]+"${bounces[@]}"})
   view_scene "$name.baked.vol.json" >"$out/$name.view.json"
   log "Eikonal $res³ $mode: render ($repeats×)"
   render=$(timed "$viewer" "$out/$name.view.json" --render "$out/$name.floor.exr" --size "${width}x$height")
   "$ring_compare" map "$out/$name.baked.vol.json" -o "$out/$name.map.json" \
-    --label "Eikonal $res³ $mode: bake (receiver map)" --time "voxelize=$vox" --time "bake=$bake" >>"$run_log" 2>&1
+    --label "Eikonal $res³ $mode$bounce_label: bake (receiver map)" --time "voxelize=$vox" --time "bake=$bake" >>"$run_log" 2>&1
   "$ring_compare" image "$out/$name.floor.exr" --camera "$camera" -o "$out/$name.image.json" \
-    --label "Eikonal $res³ $mode: viewer image" --time "render=$render" >>"$run_log" 2>&1
+    --label "Eikonal $res³ $mode$bounce_label: viewer image" --time "render=$render" >>"$run_log" 2>&1
   # The exact answer seen through this map's texels (binned by texel centre like the map): at the
   # shadow's edge a texel-centre ring mixes in its neighbour's light, bake or no bake.
   "$ring_compare" trace --through-map "$out/$name.baked.vol.json" --rays "$rays" -o "$out/$name.exact_map.json" \
@@ -275,7 +279,7 @@ if [ "$rounds" -gt 0 ] && [ "$pov" = 1 ]; then
       --interfaces sharp -q >>"$run_log" 2>&1
     t1=$(now)
     "$lightsim" "$out/$name.vol.json" -o "$out/$name.baked.vol.json" --scene "$out/bake_scene.json" \
-      --backend "$backend" -q >>"$run_log" 2>&1
+      --backend "$backend" -q ${bounces[@]+"${bounces[@]}"} >>"$run_log" 2>&1
     t2=$(now)
     "$viewer" "$out/$name.view.json" --render "$out/$name.floor.exr" --size "${width}x$height" -q >>"$run_log" 2>&1
     t3=$(now)
