@@ -89,6 +89,11 @@ nlohmann::json SimulationStats::toJson() const {
   j["rollbacks"] = rollbacks;
   j["flights"] = flights;
   if (!patch_steps_by_bounce.empty()) j["patch_steps_by_bounce"] = patch_steps_by_bounce;
+  if (!flux_received_by_bounce.empty()) {
+    nlohmann::json orders = nlohmann::json::array();
+    for (const glm::dvec3& f : flux_received_by_bounce) orders.push_back(vec3Json(f));
+    j["flux_received_by_bounce"] = std::move(orders);
+  }
   // The energy ledger: flux_in = out + absorbed + reflected + killed + unfinished + received +
   // blocked (W, RGB).
   j["flux"] = {{"in", vec3Json(flux_in)},

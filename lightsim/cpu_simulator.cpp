@@ -775,7 +775,10 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
       const PatchStepResult& r = results[i];
       const Patch& p = patches[i];
       const std::size_t bounce = static_cast<std::size_t>(std::max(p.bounce, 0));
-      if (bounce >= stats.patch_steps_by_bounce.size()) stats.patch_steps_by_bounce.resize(bounce + 1, 0);
+      if (bounce >= stats.patch_steps_by_bounce.size()) {
+        stats.patch_steps_by_bounce.resize(bounce + 1, 0);
+        stats.flux_received_by_bounce.resize(bounce + 1, glm::dvec3(0.0));
+      }
       ++stats.patch_steps_by_bounce[bounce];
       stats.flux_absorbed += r.absorbed;
       stats.flux_reflected += r.reflected;
@@ -824,6 +827,7 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
         case PatchFate::Received:
           ++stats.kills.received;
           stats.flux_received += r.received;
+          stats.flux_received_by_bounce[bounce] += r.received;
           received.push_back(static_cast<std::uint32_t>(i));
           if (options.on_leave && !insideBox(p.midpoint(), ctx.box_lo, ctx.box_hi)) options.on_leave(p);
           break;
@@ -920,6 +924,9 @@ BakeResult CpuSimulator::run(const LightSpec& light, const SimulationOptions& op
   // followed light only).
   stats.flux_in += direct.flux;
   stats.flux_received += direct.flux;
+  if (stats.flux_received_by_bounce.empty()) stats.flux_received_by_bounce.resize(1, glm::dvec3(0.0));
+  if (stats.patch_steps_by_bounce.empty()) stats.patch_steps_by_bounce.resize(1, 0);
+  stats.flux_received_by_bounce[0] += direct.flux;
   // The step's arrays go back to the allocator before the output is made, which then reuses their
   // memory (the 128³ sphere's map, 12 MB, and its file's buffers) instead of touching fresh pages.
   auto release = [](auto& v) { std::remove_reference_t<decltype(v)>().swap(v); };

@@ -1096,6 +1096,17 @@ TEST(CpuSimulator, PatchStepsAreCountedByTheReflectionsTheirLightCameThrough) {
     EXPECT_EQ(bake.stats.toJson().at("patch_steps_by_bounce").get<std::vector<std::uint64_t>>(), by_bounce);
     for (std::size_t b = 0; b < counts.size(); ++b) EXPECT_EQ(by_bounce[b], counts.back()[b]) << "order " << b;
     counts.push_back(by_bounce);
+    // The received flux by order: it adds up to the received flux (to rounding: summed in another
+    // order), and the light reflected once brings some to the floor (off the sphere below 45°).
+    const std::vector<glm::dvec3>& received = bake.stats.flux_received_by_bounce;
+    ASSERT_EQ(received.size(), by_bounce.size());
+    glm::dvec3 total(0.0);
+    for (const glm::dvec3& f : received) total += f;
+    EXPECT_NEAR(total.x, bake.stats.flux_received.x, 1e-12 * bake.stats.flux_received.x);
+    if (bounces >= 1) {
+      EXPECT_GT(received[1].x, 1e-4 * received[0].x);
+    }
+    EXPECT_EQ(bake.stats.toJson().at("flux_received_by_bounce").size(), received.size());
   }
 }
 }  // namespace

@@ -208,6 +208,9 @@ struct SimulationStats {
   // that has not been reflected); they sum to total_patches. What each order of --bounces costs.
   // Empty from the GPU path.
   std::vector<std::uint64_t> patch_steps_by_bounce;
+  // …and the flux each order put on the receiver (W, RGB; the direct light's cells in order 0): they
+  // sum to flux_received. What each order of --bounces brings.
+  std::vector<glm::dvec3> flux_received_by_bounce;
   std::map<std::string, double> phase_seconds;   // "init", "update", "analysis", "compact", "deposit", "readback", ...
   // |flux_in − (out + absorbed + reflected + killed + unfinished + received + blocked)| over the
   // largest channel of flux_in, worst channel: 0 for an exact ledger.

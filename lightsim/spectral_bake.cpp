@@ -91,6 +91,9 @@ void BandSum::add(BakeResult band) {
   if (s.patch_steps_by_bounce.size() < b.patch_steps_by_bounce.size())
     s.patch_steps_by_bounce.resize(b.patch_steps_by_bounce.size(), 0);
   for (std::size_t i = 0; i < b.patch_steps_by_bounce.size(); ++i) s.patch_steps_by_bounce[i] += b.patch_steps_by_bounce[i];
+  if (s.flux_received_by_bounce.size() < b.flux_received_by_bounce.size())
+    s.flux_received_by_bounce.resize(b.flux_received_by_bounce.size(), glm::dvec3(0.0));
+  for (std::size_t i = 0; i < b.flux_received_by_bounce.size(); ++i) s.flux_received_by_bounce[i] += b.flux_received_by_bounce[i];
   s.splits += b.splits;
   s.kills.flux += b.kills.flux;
   s.kills.exited += b.kills.exited;
