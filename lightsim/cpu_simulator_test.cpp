@@ -987,6 +987,23 @@ TEST(CpuSimulator, AReflectedWavefrontsMergedStepsStopAtAWallThinnerThanAStep) {
   EXPECT_TRUE(meets(crossing, patch));
 }
 
+// A sharp volume's bake as lightsim takes it (its defaults, free flight, straight steps of two
+// voxels, no volume deposits) onto a floor of half extent 2 at y = 0.
+SimulationOptions floorBakeOptions(const Volume& volume) {
+  SimulationOptions options;
+  const VolumeDefaults defaults = volumeDefaults(true, volume.grid);
+  options.max_depth = defaults.max_depth;
+  options.patch_voxels = defaults.patch_voxels;
+  options.split_voxels = defaults.split_voxels;
+  options.free_flight = true;
+  options.volume_deposits = false;
+  options.straight_step_voxels = 2.0;
+  ReceiverSpec floor;
+  floor.half_extent = 2.0;
+  options.receiver = floor;
+  return options;
+}
+
 // The same over a whole bake: the sphere over a floor and the wine glass (thin walls, a stem) under
 // an oblique sun, baked as lightsim bakes them, with straight steps merged and one at a time. A
 // merged patch-step ends where the steps one at a time would have, unless those steps would have
@@ -1025,18 +1042,8 @@ TEST(CpuSimulator, MergedStraightStepsBakeTheSameLightInFewerPatchSteps) {
     CpuSimulator sim(volume);
     LightSpec light;
     light.direction = glm::normalize(c.sun);
-    SimulationOptions options;
-    const VolumeDefaults defaults = volumeDefaults(true, volume.grid);
-    options.max_depth = defaults.max_depth;
-    options.patch_voxels = defaults.patch_voxels;
-    options.split_voxels = defaults.split_voxels;
-    options.free_flight = true;
-    options.volume_deposits = false;
-    options.straight_step_voxels = 2.0;
+    SimulationOptions options = floorBakeOptions(volume);
     options.bounces = c.bounces;
-    ReceiverSpec floor;
-    floor.half_extent = 2.0;
-    options.receiver = floor;
     SimulationOptions single = options;
     single.merge_straight_steps = false;
     SimulationOptions longer = single;
@@ -1069,17 +1076,7 @@ TEST(CpuSimulator, PatchStepsAreCountedByTheReflectionsTheirLightCameThrough) {
   CpuSimulator sim(volume);
   LightSpec light;
   light.direction = glm::dvec3(0.0, -1.0, 0.0);
-  SimulationOptions options;
-  const VolumeDefaults defaults = volumeDefaults(true, volume.grid);
-  options.max_depth = defaults.max_depth;
-  options.patch_voxels = defaults.patch_voxels;
-  options.split_voxels = defaults.split_voxels;
-  options.free_flight = true;
-  options.volume_deposits = false;
-  options.straight_step_voxels = 2.0;
-  ReceiverSpec floor;
-  floor.half_extent = 2.0;
-  options.receiver = floor;
+  SimulationOptions options = floorBakeOptions(volume);
   std::vector<std::vector<std::uint64_t>> counts;
   for (int bounces = 0; bounces <= 2; ++bounces) {
     SCOPED_TRACE(bounces);
