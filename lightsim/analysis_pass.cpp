@@ -51,6 +51,7 @@ void AnalysisPass::run(const PatchTextures& current, const PatchTextures& previo
   program_.set("uBounces", step.bounces);
   program_.set("uReceiverPoint", step.receiverPoint);
   program_.set("uReceiverNormal", step.receiverNormal);
+  program_.set("uPassToReceiver", step.passToReceiver);
   triangle_.draw();
   gl::checkErrors("AnalysisPass");
 }

@@ -113,6 +113,7 @@ struct StepContext {
   double voxel_volume = 0.0;
   glm::dvec3 box_lo{0.0}, box_hi{0.0};  // propagationBox
   const ReceiverMap* receiver = nullptr; // the receiver's geometry (no data), or none
+  bool torn_light_to_receiver = false;   // tornLightPassesToReceiver (with a receiver)
   // Free flight (SimulationOptions::free_flight): the quiet bricks, or none (steps of Δt only), and
   // the longest flight (world units: the propagation box's diagonal).
   const QuietMap* quiet = nullptr;
@@ -127,6 +128,11 @@ bool straightSteps(const VolumeSampler& sampler, const SimulationOptions& option
 
 // The constants of a run: Δt, the voxel volume, the propagation box (no receiver).
 StepContext makeStepContext(const VolumeSampler& sampler, const SimulationOptions& options, double flux_ref);
+// Whether a patch torn at the depth limit gives the receiver the light its corners carry past the
+// object (ALGORITHM.md "Sharp interfaces"; stepPatch's passingShare, analysis.frag's): with a
+// receiver, not in a scene's chain of boxes (on_leave: that light may meet another object), and
+// not where σa is a field only (the air may absorb along the way).
+bool tornLightPassesToReceiver(const VolumeSampler& sampler, const SimulationOptions& options);
 
 PatchStepResult stepPatch(Patch& patch, const StepContext& context);
 

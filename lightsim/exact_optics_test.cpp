@@ -212,8 +212,13 @@ SphereBake measureSphereBake(int res, const BakeResult& bake) {
     result.mean_vs_texels += deviation / counted;
     result.worst_vs_texels = std::max(result.worst_vs_texels, deviation);
   }
-  std::printf("%d³: against exact optics through the map's texels: mean %.2f %%, worst %.2f %%\n", res,
-              100.0 * result.mean_vs_texels, 100.0 * result.worst_vs_texels);
+  constexpr int edge_ring = 6;  // 0.9–1.0, just inside the shadow's edge
+  static_assert(Rings::kEdges[edge_ring] == 0.9 && Rings::kEdges[edge_ring + 1] == 1.0);
+  std::printf("%d³: against exact optics through the map's texels: mean %.2f %%, worst %.2f %%; the ring %.1f–%.1f "
+              "through them %+.2f %% of exact\n",
+              res, 100.0 * result.mean_vs_texels, 100.0 * result.worst_vs_texels, Rings::kEdges[edge_ring],
+              Rings::kEdges[edge_ring + 1],
+              100.0 * (through.irradiance[edge_ring] / exact.ringIrradiance(Rings::kEdges[edge_ring], Rings::kEdges[edge_ring + 1]) - 1.0));
   std::printf("%d³: mean deviation %.2f %%, worst %.2f %%, shadow radius %.4f, flux r<0.2 %.4f (exact %.4f), r<1 %.4f "
               "(exact %.4f); %llu patch-steps\n",
               res, 100.0 * result.mean_deviation, 100.0 * result.worst_deviation, result.rings.shadow_radius,
@@ -266,15 +271,18 @@ void expectConvergesToExactOptics(const SphereBake& coarse, const SphereBake& fi
   // resolution: the discretisation converges.
   EXPECT_LT(fine.mean_deviation, 0.10);
   EXPECT_LT(fine.mean_deviation, coarse.mean_deviation);
-  EXPECT_LT(fine.worst_deviation, 0.2);  // the dim ring 0.9–1.0 (E ≈ 0.05): 6.4 % at 48³
+  // The dim ring 0.9–1.0 (E ≈ 0.05) read by texel centres: the texels centred just inside the
+  // shadow's edge hold some of the bright floor beyond it (E ≈ 1.04), so the exact answer through
+  // the same texels reads that ring 26 % bright at 48³; the bake, measured 21–24 %, follows it.
+  EXPECT_LT(fine.worst_deviation, 0.3);
   // Against the exact answer measured through the same texels: the bounds at 128³ are 5 %
-  // mean and 10 % in every ring (BENCHMARKS.md; measured 2.2 % and 5.5 %); at 48³ measured 3.3–3.4 %
-  // and 15.8–16.3 % (the ring 0.9–1.0, where the bake's shadow edge, 0.07 % wide of r = 1, lets less of
-  // the bright floor into texels centred inside it; the patches torn at the silhouette at the depth
-  // limit die there). Splitting past 1.5 voxels instead of 1 moved that ring from 12.8 to 15.8 %
-  // of the texel-binned answer and from 10.0 to 6.4 % of the exact one; 17 % holds it to that.
-  EXPECT_LT(fine.mean_vs_texels, 0.05);
-  EXPECT_LT(fine.worst_vs_texels, 0.17);
+  // mean and 10 % in every ring (BENCHMARKS.md); at 48³ measured 1.5–1.8 % and 6.3–6.6 %. Before the
+  // patches torn at the silhouette at the depth limit gave the receiver the light of their corners
+  // that pass the sphere by (cpu_simulator.cpp passingShare), they died with it, the ring 0.9–1.0
+  // lacked the bright floor's light at the shadow's edge and read 15.8–16.3 % under this answer
+  // (3.3–3.4 % mean): these bounds fail without it.
+  EXPECT_LT(fine.mean_vs_texels, 0.025);
+  EXPECT_LT(fine.worst_vs_texels, 0.09);
   // The shadow's edge stays at the sphere's radius (the smoothed boundary put it 8 % out):
   // ±0.01 is 0.24 voxel at 48³.
   EXPECT_NEAR(fine.rings.shadow_radius, 1.0, 0.01);
@@ -338,14 +346,15 @@ SphereBake bakePlacedSphereOnFloor(int res) {
 TEST(ExactOpticsSphere, APlacedVolumeBakesTheCausticWhereTheSceneStandsIt) {
   const SphereBake coarse = bakePlacedSphereOnFloor(32);
   const SphereBake placed = bakePlacedSphereOnFloor(48);
-  // It converges as the unplaced bake does (5.1 → 2.4 %): measured 4.9 % at 32³, 2.7 % at 48³.
+  // It converges as the unplaced bake does (8.3 → 4.4 %): measured 8.3 % at 32³, 4.7 % at 48³.
   EXPECT_LT(placed.mean_deviation, coarse.mean_deviation);
   EXPECT_NEAR(coarse.rings.shadow_radius, 1.0, 0.01);
-  // The unplaced bake's bounds at 48³ (expectConvergesToExactOptics: measured 2.4 % mean, 6.4 %
-  // worst; 3.3 % and 16 % through the map's texels; the shadow's edge within 0.24 voxel).
+  // The unplaced bake's bounds at 48³ (expectConvergesToExactOptics: measured 4.4 % mean, 24 %
+  // worst in the ring 0.9–1.0 read by texel centres; 1.5 % and 6.3 % through the map's texels, here
+  // 1.1 % and 5.0 %; the shadow's edge within 0.24 voxel).
   EXPECT_LT(placed.mean_deviation, 0.05);
-  EXPECT_LT(placed.worst_deviation, 0.2);
-  EXPECT_LT(placed.mean_vs_texels, 0.05);
+  EXPECT_LT(placed.worst_deviation, 0.3);
+  EXPECT_LT(placed.mean_vs_texels, 0.025);
   EXPECT_NEAR(placed.rings.shadow_radius, 1.0, 0.01);
   EXPECT_NEAR(placed.rings.encircled_1 / exactSphereOnFloor().encircledFlux(1.0), 1.0, 0.03);
 }
@@ -811,8 +820,12 @@ TEST(ExactOpticsSphere, StraightStepsBakeTheSameCausticInFewerSteps) {
               static_cast<unsigned long long>(straight.stats.total_patches),
               static_cast<unsigned long long>(flown.stats.total_patches));
   EXPECT_LT(map, 0.01);
+  // The ring 0.9–1.0 within 3 %: its texels straddling the shadow's edge hold the light of the
+  // patches torn there at the depth limit that passes the sphere (a quarter of a patch per corner),
+  // and where the steps end moves which patches tear (measured 2.3 %, 0.0014 W/m² of its 0.06).
   for (int k = 0; k < Rings::kCount; ++k)
-    EXPECT_NEAR(straight.rings.irradiance[k] / flown.rings.irradiance[k], 1.0, 0.01) << "ring " << k;
+    EXPECT_NEAR(straight.rings.irradiance[k] / flown.rings.irradiance[k], 1.0, Rings::kEdges[k] == 0.9 ? 0.03 : 0.01)
+        << "ring " << k;
   EXPECT_NEAR(straight.stats.flux_received.x, flown.stats.flux_received.x, 1e-3 * flown.stats.flux_received.x);
   expectConvergesToExactOptics(bakeSphereOnFloor(32, Stepping::Straight), straight);
 }

@@ -373,6 +373,7 @@ BakeResult GpuSimulator::Impl::run(const LightSpec& light, const SimulationOptio
   if (options.receiver) {
     step.receiverPoint = glm::vec3(receiver.point - origin);
     step.receiverNormal = glm::vec3(receiver.normal);
+    step.passToReceiver = tornLightPassesToReceiver(sampler, options);
   }
   // E_ref of the max-mode depth mapping: a small irradiance, so that bright patches get depths near
   // 0 where Depth32F is most precise (largest initial E / 1000).

@@ -35,6 +35,8 @@ void LedgerPass::addStep(const StepTargets& targets, const PatchTextures& curren
         [&] {
           targets.ledgerA.bind(0);
           extra_.setSampler("uLedgerA", 0);
+          targets.ledgerB.bind(1);  // a torn patch's share received (ledger.vert)
+          extra_.setSampler("uLedgerB", 1);
           current.texture(PatchTextures::kFlux).bind(2);
           extra_.setSampler("uFlux", 2);
         },

@@ -37,6 +37,9 @@ struct StepUniforms {
   int bounces = 0;                              // reflections followed (sharp interfaces)
   // The receiver plane (RECEIVER in the analysis pass), in the grid's frame.
   glm::vec3 receiverPoint{0.0f}, receiverNormal{0.0f, 1.0f, 0.0f};
+  // A patch torn at the depth limit gives the receiver the light its corners carry past the object
+  // (analysis.frag passingShare, the twin's); off in a scene's chain of boxes (on_leave).
+  bool passToReceiver = false;
 
   // The uniforms of a run of `options` on `grid`, whose largest initial patch flux is Φ_ref =
   // fluxRef (initialPatches): Δt = timeStep, the split length splitThreshold, the box

@@ -33,6 +33,8 @@ const int kMaxTotalReflections = 16;  // cpu_simulator.cpp: trapped by total int
 #ifdef RECEIVER
 uniform vec3 uReceiverPoint;   // the plane, in the grid's local coordinates
 uniform vec3 uReceiverNormal;  // unit, facing the light
+uniform bool uPassToReceiver;  // a patch torn at the depth limit gives the receiver the light that
+                               // passes the object by (passingShare; not in a scene's chain of boxes)
 #endif
 
 uniform sampler2D uPatch[8];      // the list after the update
@@ -57,6 +59,33 @@ bool footprintExists(Patch p) {
     if (facing == 0.0 || (facing > 0.0 && dot(p.x[c] - uReceiverPoint, uReceiverNormal) > 0.0)) return false;
   }
   return true;
+}
+#endif
+
+#if defined(SHARP_INTERFACES) && defined(RECEIVER) && defined(DEPOSIT_TRACK)
+// passingShare (cpu_simulator.cpp): a patch torn at the depth limit, as it was before the step;
+// `met` the corners that met the surface. Each other corner in air whose straight ray meets no
+// interface before it leaves the box or reaches the plane carries a quarter of the patch's light
+// straight to the receiver. 0 when a corner is not in air or the footprint does not exist.
+float passingShare(Patch p, int met) {
+  if (!uPassToReceiver) return 0.0;
+  int passing = 0;
+  for (int c = 0; c < 4; ++c) {
+    if (p.medium[c] != -1) return 0.0;
+    if (((met >> c) & 1) != 0) continue;
+    vec3 d = normalize(p.w[c]);
+    float facing = dot(d, uReceiverNormal);
+    float above = dot(p.x[c] - uReceiverPoint, uReceiverNormal);
+    if (!(facing < 0.0) || !(above > 0.0)) continue;
+    float tEnd = -above / facing;
+    for (int a = 0; a < 3; ++a)
+      if (d[a] != 0.0) tEnd = min(tEnd, ((d[a] > 0.0 ? uBoxMax[a] : uBoxMin[a]) - p.x[c][a]) / d[a]);
+    float f;
+    int k, entered;
+    if (tEnd > 0.0 && findInterfaceOnChord(p.x[c], p.x[c] + tEnd * d, -1, f, k, entered)) continue;
+    ++passing;
+  }
+  return passing > 0 && footprintExists(p) ? 0.25 * float(passing) : 0.0;
 }
 #endif
 
@@ -108,6 +137,15 @@ void main() {
   if ((p.event & SHARP_EVENT_TORN) != 0) {
     oCount = vec4(0.0);
     oLedgerA = vec4(0.0, 0.0, 0.0, float(FATE_DEPTH));
+#if defined(RECEIVER) && defined(DEPOSIT_TRACK)
+    // The light it carries past the object goes to the receiver (its footprint, this flux), and
+    // the ledger's B says which share of its flux that is (w = −share: received, not killed).
+    float share = passingShare(p, p.event / SHARP_EVENT_MET_UNIT);
+    if (share > 0.0) {
+      oDepositB = vec4(share * p.flux, 1.0);
+      oLedgerB = vec4(0.0, 0.0, 0.0, -share);
+    }
+#endif
     return;
   }
   vec3 a = stepAbsorptionFactor(mOld, fluxOld, p.flux, p.tFresnel);

@@ -37,21 +37,27 @@ void main() {
   int fate = fateOf(code);
   vec4 dead = vec4(texelFetch(uFlux, texel, 0).rgb, 1.0);
   if (fate == FATE_RECEIVED) vEntry[0] = dead;
+  // A patch torn at the depth limit whose passing corners' light went to the receiver (ledger B's
+  // w = −share, analysis.frag passingShare): that share is received (not counted as a patch).
+  float passing = fate == FATE_DEPTH ? max(-texelFetch(uLedgerB, texel, 0).w, 0.0) : 0.0;
+  if (passing > 0.0) vEntry[0] = vec4(dead.rgb * passing, 0.0);
   if (fate == FATE_BLOCKED) vEntry[1] = dead;
   if (fateSpawns(code)) vEntry[2] = vec4(0.0, 0.0, 0.0, 1.0);
   if (fateRolledBack(code)) vEntry[3] = vec4(0.0, 0.0, 0.0, 1.0);
-  emit = fate == FATE_RECEIVED || fate == FATE_BLOCKED || code >= FATE_SPAWNS;
+  emit = fate == FATE_RECEIVED || fate == FATE_BLOCKED || code >= FATE_SPAWNS || passing > 0.0;
 #else
   vec4 a = texelFetch(uLedgerA, texel, 0);
   vec4 b = texelFetch(uLedgerB, texel, 0);
   int fate = fateOf(int(a.w + 0.5));
   vEntry[0] = vec4(a.rgb, 0.0);
-  vEntry[1] = b;
+  // b.w < 0: not a reflection but the share of a patch torn at the depth limit that was received.
+  float passing = b.w < 0.0 ? -b.w : 0.0;
+  vEntry[1] = passing > 0.0 ? vec4(0.0) : b;
   vec4 dead = fate >= FATE_EXITED ? vec4(texelFetch(uFlux, texel, 0).rgb, 1.0) : vec4(0.0);
   if (fate == FATE_EXITED) vEntry[2] = dead;
   if (fate == FATE_FLUX) vEntry[3] = dead;
   if (fate == FATE_FOLDED) vEntry[4] = dead;
-  if (fate == FATE_DEPTH) vEntry[5] = dead;
+  if (fate == FATE_DEPTH) vEntry[5] = vec4(dead.rgb * (1.0 - passing), 1.0);
   if (fate == FATE_TRAPPED) vEntry[7] = dead;  // trapped light is unfinished light
   if (fateSplits(fate)) vEntry[6] = vec4(0.0, 0.0, 0.0, 1.0);
   emit = fate >= FATE_SPLIT || b.w > 0.0 || any(notEqual(b.rgb, vec3(0.0))) || any(greaterThan(a.rgb, vec3(0.0)));

@@ -37,6 +37,9 @@ const int SHARP_EVENT_SPLIT_U = 1;
 const int SHARP_EVENT_SPLIT_V = 2;
 const int SHARP_EVENT_TORN = 4;
 const int SHARP_EVENT_BLOCKED = 8;
+// With SHARP_EVENT_TORN: the mask of the corners that met the surface, times this (bits 6–9; the
+// blocked count, 8 per corner, stays below it).
+const int SHARP_EVENT_MET_UNIT = 64;
 void unpackSharpMeta(vec4 m, inout Patch p) {
   float rest = floor(m.x / 64.0);
   p.depth = m.x - 64.0 * rest;

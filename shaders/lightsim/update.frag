@@ -15,7 +15,8 @@
 // patch keeps Π (1 − R_c)^¼ of its flux. A step that would tear the patch — stretched past
 // kTearFactor split lengths, or a first touch whose other corners will not meet the same surface
 // (willTear) — is undone and the event tells the analysis to split the patch as it was
-// (SHARP_EVENT_SPLIT_U/V), or, at the depth limit, that it dies (SHARP_EVENT_TORN).
+// (SHARP_EVENT_SPLIT_U/V), or, at the depth limit, that it dies (SHARP_EVENT_TORN, with the corners
+// that met the surface: SHARP_EVENT_MET_UNIT times their mask).
 // FREE_FLIGHT / ABSORBER_MAP (flight.glsl): a patch in quiet space crosses it in one straight step;
 // with sharp interfaces an ordinary step is a straight step (uStepDt) where they apply.
 #include "common/volume.glsl"
@@ -175,7 +176,9 @@ void main() {
     bool firstTouch = met != 15;
     bool tears = stretched || (firstTouch && willTear(p, met, 4.0 * max(longestEdge(p), uVoxelEdge)));
     if (tears && p.depth >= uMaxDepth) {
-      before.event = SHARP_EVENT_TORN;  // dies before it deposits anything
+      // Dies before it deposits anything, but for the light its corners carry past the object
+      // (the analysis, passingShare): which corners met the surface, in the event's bits 6–9.
+      before.event = SHARP_EVENT_TORN + SHARP_EVENT_MET_UNIT * met;
       writePatch(before);
       return;
     }
