@@ -35,7 +35,8 @@
 #   --exact FILE   the exact tracer's JSON of an earlier run instead of tracing again
 #   --bounces B    lightsim's --bounces for every bake (default: lightsim's, one). On the sphere the
 #                  light reflected three times inside it lands in the rings 0.4–0.9: with 3 the
-#                  floor's error falls below POV-Ray's at 150 k photons (BENCHMARKS.md, thirty-first part)
+#                  floor's error (0.4 %) falls below POV-Ray's at 1.6 M photons (BENCHMARKS.md,
+#                  thirty-first and thirty-second parts)
 #   --rounds R     then R rounds, alternated, of the whole pipeline (voxelize + bake + render at the
 #                  first --res) and POV-Ray at the first photon count, one after the other in each
 #                  round: both feel the machine's load alike. Prints their medians, the ratio of the
