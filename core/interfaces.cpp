@@ -39,7 +39,8 @@ bool boolean(const nlohmann::json& j, const std::string& source, const std::stri
 
 }  // namespace
 
-MaterialValues deepMaterialValues(const Volume& volume, const InterfaceTable& table, const Field& field, double depth) {
+MaterialValues deepMaterialValues(const Volume& volume, const InterfaceTable& table, const Field& field, double depth,
+                                  bool with_air) {
   const int slots = static_cast<int>(table.slots.size());
   const std::size_t media = static_cast<std::size_t>(slots) + 1;
   MaterialValues result;
@@ -71,6 +72,7 @@ MaterialValues deepMaterialValues(const Volume& volume, const InterfaceTable& ta
       if (!deep) continue;
       const int slot = materialSlot(distances, slots);
       if (slot >= 0 && table.slots[static_cast<std::size_t>(slot)].opaque) continue;
+      if (slot < 0 && !with_air) continue;
       const std::size_t m = static_cast<std::size_t>(slot + 1);
       glm::dvec3 x(0.0);
       for (int c = 0; c < components; ++c) x[c] = field.voxel(v)[c];

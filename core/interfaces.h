@@ -69,13 +69,15 @@ InterfaceTable interfaceTable(const Volume& volume, const std::string& source = 
 // only within a voxel of their surfaces). Index 0 is air, 1 + k slot k; opaque slots are not
 // looked at (no ray goes on in them). `one_value` is false when a material's deep voxels disagree
 // (beyond a relative 1e-6: two objects of one n and different σa share a slot; smoke in the air);
-// a material with no deep voxel (a wall thinner than two voxels) is not `seen`.
+// a material with no deep voxel (a wall thinner than two voxels) is not `seen`. Without `with_air`
+// the air is not looked at either (its field may vary: smoke in a box, viewer/volume_analysis.h).
 struct MaterialValues {
   bool one_value = true;
   std::vector<bool> seen;          // [0] air, [1 + k] slot k
   std::vector<glm::dvec3> value;   // where seen (unused components 0)
 };
-MaterialValues deepMaterialValues(const Volume& volume, const InterfaceTable& table, const Field& field, double depth);
+MaterialValues deepMaterialValues(const Volume& volume, const InterfaceTable& table, const Field& field, double depth,
+                                  bool with_air = true);
 // The depth, in (smallest) voxel edges, beyond which a voxel is deep inside its material: a voxel
 // cube's corners lie √3/2 edges from its centre, so nothing of another object is blended in.
 constexpr double kDeepVoxels = 1.0;

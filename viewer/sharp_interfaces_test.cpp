@@ -708,5 +708,42 @@ TEST_F(SharpViewerTest, ConstantMediaScatterAndAbsorbAsTheClosedFormSays) {
   }
 }
 
+// Smoke in a box around a glass ball (the amber bunny's setting: the smoke has n = 1, no surface of
+// its own), under a uniform baked light E along l, black sky, seen along −z beside the ball. The
+// march takes the smoke's σa and ω̂ as constants over the share of each step inside its box
+// (viewer/volume_analysis.h AirBox). Closed form (Eq. 5.10 with Eq. 3.4, 5.7; no surface on the
+// way): L = ω̂·p·E·(1 − e^(−σ·d))/σ, d = 0.77 the box's depth, its faces off the voxel lattice.
+TEST_F(SharpViewerTest, SmokeInABoxScattersAndAbsorbsAsTheClosedFormSays) {
+  const glm::dvec3 sigma(0.5, 2.0, 4.0);
+  const double albedo = 0.6, g = 0.4, E = 2.0, d = 0.77;
+  const glm::dvec3 l = glm::normalize(glm::dvec3(0.0, -0.6, 0.8));
+  const double phase = (1 - g * g) / (4 * std::numbers::pi * std::pow(1 + g * g - 2 * g * l.z, 1.5));
+  for (int res : {32, 48}) {
+    Volume v = sharpVolume(std::vector<std::string>{"procedural:sphere,r=0.15,center=0:0:0,ior=1.5",
+                            "procedural:box,size=0.7:0.62:0.77,center=0.03:-0.02:0.01,ior=1,sigma_a=0.5:2:4,scatter=0.6,g=0.4"},
+                           res, box({-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6}));
+    ASSERT_TRUE(slotMedia(v, interfaceTable(v)).air_box.has_value()) << "the march must read the smoke's constants";
+    Field& irradiance = v.addField("irradiance", 3);
+    Field& light_dir = v.addField("light_dir", 3);
+    for (std::size_t i = 0; i < v.grid.count(); ++i)
+      for (int c = 0; c < 3; ++c) {
+        irradiance.voxel(i)[c] = static_cast<float>(E);
+        light_dir.voxel(i)[c] = static_cast<float>(l[c]);
+      }
+    LoadedScene scene = oneObject(std::move(v));
+    scene.scene.environment.uniform = glm::dvec3(0.0);
+    // Rays at x = −0.2, the smoke's and the volume's faces crossed at right angles, the ball missed.
+    const Image image = SceneRenderer(*shaders_, scene, RenderSettings{}).render(lookAlong({-0.2, 0, 4}, {0, 0, -1}, 0.5), {9, 9});
+    for (int c = 0; c < 3; ++c) {
+      const double expected = albedo * phase * E * (1 - std::exp(-sigma[c] * d)) / sigma[c];
+      std::printf("smoke box %d^3: channel %d %.5f, closed form %.5f\n", res, c, image.at(4, 4)[c], expected);
+      // The attenuation within a step is integrated exactly and the faces are exact (the share of
+      // the step in the box), so what is left is float rounding: 0.2 %. (The fetched σa and ω̂,
+      // blended over a voxel at each face, were 0.8–6.5 % low at 32³, 0.6–4.8 % at 48³.)
+      EXPECT_NEAR(image.at(4, 4)[c], expected, 0.002 * expected) << res << "^3, channel " << c;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace eik

@@ -1,9 +1,12 @@
 // The viewer's volume analysis on small hand-made volumes: the active region and the absorbing
 // region with their one-voxel margins (clamped to the box), the homogeneous bricks with their
-// margins, whether the material touches the box, and the constant media of sharp materials.
+// margins, whether the material touches the box, the constant media of sharp materials, and the
+// box of smoke in the air (on voxelized procedural shapes).
 #include "viewer/volume_analysis.h"
 
 #include <gtest/gtest.h>
+
+#include "lightsim/test_scenes.h"
 
 #include <algorithm>
 #include <cmath>
@@ -335,6 +338,64 @@ TEST(SlotMedia, VaryWhereAMaterialDisagreesWithItselfOrIsNeverDeep) {
     EXPECT_FALSE(media.sigma_a_constant);
     EXPECT_FALSE(media.scatter_constant);
   }
+}
+
+// A glass ball in a box of smoke (ior 1: no surface of its own, so the air's σa and ω̂ vary), as
+// voxelize writes it: the smoke's faces where the coverage of their voxels puts them, off the
+// voxel lattice on every axis.
+const char* kSmokeBox = "procedural:box,size=0.7:0.62:0.77,center=0.03:-0.02:0.01,ior=1,sigma_a=0.5:2:4,scatter=0.6,g=0.4";
+const char* kGlassBall = "procedural:sphere,r=0.15,center=0:0:0,ior=1.5,sigma_a=0.25:0.5:1,scatter=0.3,g=0.2";
+
+TEST(AirMediumBox, IsTheSmokesBoxWithItsFacesWhereTheirCoverageSays) {
+  for (int res : {32, 45}) {
+    const Volume v = test_scenes::sharpVolume(std::vector<std::string>{kGlassBall, kSmokeBox}, res,
+                                              test_scenes::box({-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6}));
+    const InterfaceTable table = interfaceTable(v);
+    ASSERT_EQ(table.slots.size(), 1u) << "the smoke has no surface of its own";
+    const SlotMedia media = slotMedia(v, table);
+    ASSERT_TRUE(media.sigma_a_constant && media.scatter_constant) << res;
+    ASSERT_TRUE(media.air_box.has_value()) << res;
+    const glm::dvec3 lo(0.03 - 0.35, -0.02 - 0.31, 0.01 - 0.385), hi(0.03 + 0.35, -0.02 + 0.31, 0.01 + 0.385);
+    for (int c = 0; c < 3; ++c) {
+      // The voxelizer's coverage of a face parallel to an axis is exact (implicit_voxelizer.h);
+      // what is left is float rounding of the shares: 1e-6 of the box.
+      EXPECT_NEAR(media.air_box->lo[c], lo[c], 1e-6) << res << " lo " << c;
+      EXPECT_NEAR(media.air_box->hi[c], hi[c], 1e-6) << res << " hi " << c;
+    }
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(media.air_box->inside.sigma_a[c], glm::dvec3(0.5, 2, 4)[c], 1e-6);
+    EXPECT_NEAR(media.air_box->inside.scatter.x, 0.6, 1e-6);
+    EXPECT_NEAR(media.air_box->inside.scatter.y, 0.4, 1e-6);
+    EXPECT_EQ(media.media[0].sigma_a, glm::dvec3(0.0)) << "outside the box the air is clear";
+    EXPECT_EQ(media.media[0].scatter, glm::dvec2(0.0));
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(media.media[1].sigma_a[c], glm::dvec3(0.25, 0.5, 1)[c], 1e-6);
+    EXPECT_NEAR(media.media[1].scatter.x, 0.3, 1e-6);
+  }
+}
+
+TEST(AirMediumBox, IsNoneWhereTheSmokeIsNotOneBoxOfOneValue) {
+  const Bounds bounds = test_scenes::box({-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6});
+  auto media = [&](std::vector<std::string> specs) {
+    const Volume v = test_scenes::sharpVolume(specs, 32, bounds);
+    return slotMedia(v, interfaceTable(v));
+  };
+  // A ball of smoke: its bounding box holds clear air in the corners.
+  SlotMedia ball = media({kGlassBall, "procedural:sphere,r=0.45,center=0:0:0,ior=1,sigma_a=0.5:2:4,scatter=0.6"});
+  EXPECT_FALSE(ball.air_box.has_value());
+  EXPECT_FALSE(ball.sigma_a_constant);
+  // Two boxes of smoke side by side, one denser.
+  SlotMedia two = media({kGlassBall, "procedural:box,size=0.4:0.8:0.8,center=-0.2:0:0,ior=1,sigma_a=0.5:2:4,scatter=0.6",
+                         "procedural:box,size=0.4:0.8:0.8,center=0.2:0:0,ior=1,sigma_a=1:2:4,scatter=0.6"});
+  EXPECT_FALSE(two.air_box.has_value());
+  EXPECT_FALSE(two.sigma_a_constant);
+  // Two boxes of the same smoke with clear air between them.
+  SlotMedia apart = media({kGlassBall, "procedural:box,size=0.3:0.8:0.8,center=-0.3:0:0,ior=1,sigma_a=0.5:2:4",
+                           "procedural:box,size=0.3:0.8:0.8,center=0.3:0:0,ior=1,sigma_a=0.5:2:4"});
+  EXPECT_FALSE(apart.air_box.has_value());
+  EXPECT_FALSE(apart.sigma_a_constant);
+  // Clear air: every material's constants without a box.
+  SlotMedia clear = media({kGlassBall});
+  EXPECT_FALSE(clear.air_box.has_value());
+  EXPECT_TRUE(clear.sigma_a_constant && clear.scatter_constant);
 }
 
 }  // namespace

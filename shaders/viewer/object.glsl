@@ -401,7 +401,7 @@ bool skipHomogeneousBrick@(inout March@ m, vec3 uvw) {
     float L = min(min(toFace.x, toFace.y), toFace.z) + 0.01 * m.h;
     if (!m.inLayer) rememberStateBeforeLayer@(m, length(m.w), dir);  // a quiet stretch
 #if defined(ATTENUATION) && defined(SIGMA_A_BY_MATERIAL)
-    m.tau += MEDIUM_SIGMA_A(m.medium) * (L * uObjLengthScale[@]);  // Beer–Lambert, σa constant here
+    m.tau += MEDIUM_SIGMA_A(m.medium) * (L * uObjLengthScale[@] * mediumShare@(m, m.x, m.x + dir * L));  // Beer–Lambert, σa constant here
 #elif defined(ATTENUATION) && defined(HAS_SIGMA_A)
     m.tau += volumeSigmaA(uvw) * (L * uObjLengthScale[@]);
 #endif
@@ -460,6 +460,24 @@ void followBoundaryLayer@(inout Ray r, inout March@ m, vec3 grad, float grad2, b
     m.w = renormalised(m.w, m.n, m.gradPeak);
     crossBoundary@(r, m.nBefore, m.n, m.dBefore, m.gradPeak, m.uvwPeak, r.T * exp(-m.tauBefore));
   }
+}
+
+// The share of the straight stretch a → b (volume coordinates) that the air's medium fills: with
+// smoke in a box (AIR_BOX, viewer/volume_analysis.h AirBox; MEDIUM_SIGMA_A and MEDIUM_SCATTER give
+// the air's inside it) the part of a → b in the box (slabs), else all of it.
+float mediumShare@(March@ m, vec3 a, vec3 b) {
+#ifdef AIR_BOX
+  if (m.medium >= 0) return 1.0;
+  vec3 d = b - a;
+  vec3 inv = 1.0 / mix(vec3(1e-30), d, greaterThan(abs(d), vec3(1e-30)));
+  vec3 t0 = (AIR_BOX_MIN - a) * inv, t1 = (AIR_BOX_MAX - a) * inv;
+  vec3 tNear = min(t0, t1), tFar = max(t0, t1);
+  float enter = clamp(max(max(tNear.x, tNear.y), tNear.z), 0.0, 1.0);
+  float leave = clamp(min(min(tFar.x, tFar.y), tFar.z), 0.0, 1.0);
+  return max(leave - enter, 0.0);
+#else
+  return 1.0;
+#endif
 }
 
 // Beer–Lambert over the step hs (Eq. 3.4, per channel: T = exp(−τ)). σa is the constant of the
@@ -535,7 +553,13 @@ float stepLength@(March@ m, vec3 uvw, float grad2) {
   // steps of one voxel sampled at their start, BENCHMARKS.md); in the others the ray steps on to
   // the next surface.
   float reach = max(m.h, nearest * 0.57735);
-  return MEDIUM_SCATTER(m.medium).x > 0.0 ? min(reach, 4.0 * m.h) : reach;
+  bool scatters = MEDIUM_SCATTER(m.medium).x > 0.0;
+#ifdef AIR_BOX
+  // Smoke in the air: sampled near its box (a step from outside may reach 2.3 voxels into it).
+  scatters = scatters && (m.medium >= 0 || all(greaterThan(m.x, AIR_BOX_MIN - 4.0 * m.h)) &&
+                                               all(lessThan(m.x, AIR_BOX_MAX + 4.0 * m.h)));
+#endif
+  return scatters ? min(reach, 4.0 * m.h) : reach;
 #endif
 #endif
   quiet = quiet && nearest > 4.0 * m.h;
@@ -549,9 +573,16 @@ float stepLength@(March@ m, vec3 uvw, float grad2) {
 // to cross a sharp surface, or from crossInterface@ up to the surface).
 void gatherMedium@(inout Ray r, inout March@ m, vec3 uvw, float hs) {
   float ds = hs * uObjLengthScale[@];  // the step in world units: σa, L_e and the baked light are per world unit
-  absorb@(m, uvw, ds);
+#ifdef AIR_BOX
+  // The step is straight (the air's n is 1): its ends from its middle and direction.
+  vec3 middle = m.bmin + uvw / m.invExtent, halfStep = (0.5 * hs) * normalize(m.w);
+  float inMedium = ds * mediumShare@(m, middle - halfStep, middle + halfStep);
+#else
+  float inMedium = ds;
+#endif
+  absorb@(m, uvw, inMedium);
   emit@(r, m, uvw, ds);
-  inScatter@(r, m, uvw, ds);
+  inScatter@(r, m, uvw, inMedium);
 }
 
 // One step of the ray equation in arc length (Eq. 5.11/5.12, the discrete Eq. 4.8/4.9):
