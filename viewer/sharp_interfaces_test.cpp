@@ -37,6 +37,19 @@ class SharpViewerTest : public GlSuiteTest {
     loaded.scene.environment.uniform = glm::dvec3(1.0);
     return loaded;
   }
+  // The volume as one object under a baked light E along l everywhere, black sky.
+  static LoadedScene underUniformLight(Volume v, double E, const glm::dvec3& l) {
+    Field& irradiance = v.addField("irradiance", 3);
+    Field& light_dir = v.addField("light_dir", 3);
+    for (std::size_t i = 0; i < v.grid.count(); ++i)
+      for (int c = 0; c < 3; ++c) {
+        irradiance.voxel(i)[c] = static_cast<float>(E);
+        light_dir.voxel(i)[c] = static_cast<float>(l[c]);
+      }
+    LoadedScene loaded = oneObject(std::move(v));
+    loaded.scene.environment.uniform = glm::dvec3(0.0);
+    return loaded;
+  }
 };
 
 Camera lookAlong(const glm::dvec3& eye, const glm::dvec3& dir, double fov_deg, const glm::dvec3& up = {0, 1, 0}) {
@@ -685,15 +698,7 @@ TEST_F(SharpViewerTest, ConstantMediaScatterAndAbsorbAsTheClosedFormSays) {
                            res, box({-0.6, -0.6, -0.75}, {0.6, 0.6, 0.75}));
     const SlotMedia media = slotMedia(v, interfaceTable(v));
     ASSERT_TRUE(media.sigma_a_constant && media.scatter_constant) << "the march must read the constants";
-    Field& irradiance = v.addField("irradiance", 3);
-    Field& light_dir = v.addField("light_dir", 3);
-    for (std::size_t i = 0; i < v.grid.count(); ++i)
-      for (int c = 0; c < 3; ++c) {
-        irradiance.voxel(i)[c] = static_cast<float>(E);
-        light_dir.voxel(i)[c] = static_cast<float>(l[c]);
-      }
-    LoadedScene scene = oneObject(std::move(v));
-    scene.scene.environment.uniform = glm::dvec3(0.0);
+    LoadedScene scene = underUniformLight(std::move(v), E, l);
     const Image image = SceneRenderer(*shaders_, scene, RenderSettings{}).render(lookAlong({0, 0, 4}, {0, 0, -1}, 4.0), {9, 9});
     for (int c = 0; c < 3; ++c) {
       std::printf("constant media %d^3: channel %d %.5f, closed form %.5f\n", res, c, image.at(4, 4)[c], expected[c]);
@@ -723,15 +728,7 @@ TEST_F(SharpViewerTest, SmokeInABoxScattersAndAbsorbsAsTheClosedFormSays) {
                             "procedural:box,size=0.7:0.62:0.77,center=0.03:-0.02:0.01,ior=1,sigma_a=0.5:2:4,scatter=0.6,g=0.4"},
                            res, box({-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6}));
     ASSERT_TRUE(slotMedia(v, interfaceTable(v)).air_box.has_value()) << "the march must read the smoke's constants";
-    Field& irradiance = v.addField("irradiance", 3);
-    Field& light_dir = v.addField("light_dir", 3);
-    for (std::size_t i = 0; i < v.grid.count(); ++i)
-      for (int c = 0; c < 3; ++c) {
-        irradiance.voxel(i)[c] = static_cast<float>(E);
-        light_dir.voxel(i)[c] = static_cast<float>(l[c]);
-      }
-    LoadedScene scene = oneObject(std::move(v));
-    scene.scene.environment.uniform = glm::dvec3(0.0);
+    LoadedScene scene = underUniformLight(std::move(v), E, l);
     // Rays at x = −0.2, the smoke's and the volume's faces crossed at right angles, the ball missed.
     const Image image = SceneRenderer(*shaders_, scene, RenderSettings{}).render(lookAlong({-0.2, 0, 4}, {0, 0, -1}, 0.5), {9, 9});
     for (int c = 0; c < 3; ++c) {
