@@ -96,6 +96,142 @@ MaterialValues deepMaterialValues(const Volume& volume, const InterfaceTable& ta
   return result;
 }
 
+std::optional<AirMedium> airMediumBox(const Volume& volume, const InterfaceTable& table, double depth) {
+  const Field* interfaces = volume.find("interfaces");
+  const Field* sigma = volume.find("sigma_a");
+  const Field* scatter = volume.find("scatter");
+  const int slots = static_cast<int>(table.slots.size());
+  if (!interfaces || slots == 0 || (!sigma && !scatter)) return std::nullopt;
+  const GridSpec& grid = volume.grid;
+  const glm::ivec3 dims = grid.dims;
+  auto deepAir = [&](std::size_t v) {
+    const float* d = interfaces->voxel(v);
+    glm::dvec4 distances(1e30);
+    for (int k = 0; k < slots; ++k) {
+      if (std::abs(d[k]) < depth) return false;
+      distances[k] = d[k];
+    }
+    return materialSlot(distances, slots) < 0;
+  };
+  // What blends by coverage: σa (rgb) and ω̂ (a); g is the smoke's wherever ω̂ is not 0.
+  auto valueAt = [&](std::size_t v) {
+    glm::dvec4 x(0.0);
+    if (sigma)
+      for (int c = 0; c < 3; ++c) x[c] = sigma->voxel(v)[c];
+    if (scatter) x.w = scatter->voxel(v)[0];
+    return x;
+  };
+  auto gAt = [&](std::size_t v) { return scatter && scatter->components > 1 ? double(scatter->voxel(v)[1]) : 0.0; };
+  // The box of the deep air voxels that are not 0, z-slices in parallel.
+  std::vector<glm::ivec3> slice_min(static_cast<std::size_t>(dims.z), dims), slice_max(static_cast<std::size_t>(dims.z), glm::ivec3(-1));
+  parallelFor(0, dims.z, [&](std::int64_t z64) {
+    const int z = static_cast<int>(z64);
+    for (int y = 0; y < dims.y; ++y)
+      for (int x = 0; x < dims.x; ++x) {
+        const std::size_t v = grid.index(x, y, z);
+        if (valueAt(v) == glm::dvec4(0.0) || !deepAir(v)) continue;
+        slice_min[static_cast<std::size_t>(z)] = glm::min(slice_min[static_cast<std::size_t>(z)], glm::ivec3(x, y, z));
+        slice_max[static_cast<std::size_t>(z)] = glm::max(slice_max[static_cast<std::size_t>(z)], glm::ivec3(x, y, z));
+      }
+  });
+  glm::ivec3 lo(dims), hi(-1);
+  for (std::size_t z = 0; z < slice_min.size(); ++z) {
+    lo = glm::min(lo, slice_min[z]);
+    hi = glm::max(hi, slice_max[z]);
+  }
+  if (hi.x < 0 || glm::any(glm::lessThan(hi - lo, glm::ivec3(2)))) return std::nullopt;  // none, or no inside
+  // The one value inside (every deep air voxel off the box's faces' layer).
+  auto inner = [&](int x, int y, int z) { return x > lo.x && x < hi.x && y > lo.y && y < hi.y && z > lo.z && z < hi.z; };
+  auto differ = [](double a, double b) { return std::abs(a - b) > 1e-6 * (1.0 + std::abs(b)); };
+  bool one = true, seen = false;
+  glm::dvec4 c(0.0);
+  double g = 0.0;
+  for (int z = lo.z + 1; z < hi.z && one; ++z)
+    for (int y = lo.y + 1; y < hi.y && one; ++y)
+      for (int x = lo.x + 1; x < hi.x && one; ++x) {
+        const std::size_t v = grid.index(x, y, z);
+        if (!deepAir(v)) continue;
+        const glm::dvec4 value = valueAt(v);
+        if (!seen) {
+          seen = true;
+          c = value;
+          g = gAt(v);
+        }
+        for (int k = 0; k < 4; ++k) one = one && !differ(value[k], c[k]);
+        one = one && (c.w == 0.0 || !differ(gAt(v), g));
+      }
+  if (!one || !seen || c == glm::dvec4(0.0)) return std::nullopt;
+  // Each face layer's voxels: the share f of the inside value they hold (by the largest component).
+  int dominant = 0;
+  for (int k = 1; k < 4; ++k)
+    if (c[k] > c[dominant]) dominant = k;
+  auto share = [&](std::size_t v) { return valueAt(v)[dominant] / c[dominant]; };
+  auto proportional = [&](std::size_t v, double f) {
+    const glm::dvec4 value = valueAt(v);
+    for (int k = 0; k < 4; ++k)
+      if (std::abs(value[k] - f * c[k]) > 1e-5 * (1.0 + std::abs(c[k]))) return false;
+    return value.w == 0.0 || !differ(gAt(v), g);
+  };
+  // A face's share from its voxels off the box's edges.
+  glm::dvec3 share_lo(0.0), share_hi(0.0);
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      double sum = 0.0;
+      int count = 0;
+      const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+      for (int i = lo[a] + 1; i < hi[a]; ++i)
+        for (int j = lo[b] + 1; j < hi[b]; ++j) {
+          glm::ivec3 p;
+          p[axis] = side ? hi[axis] : lo[axis];
+          p[a] = i;
+          p[b] = j;
+          const std::size_t v = grid.index(p.x, p.y, p.z);
+          if (!deepAir(v)) continue;
+          sum += share(v);
+          ++count;
+        }
+      if (count == 0) return std::nullopt;
+      (side ? share_hi : share_lo)[axis] = sum / count;
+    }
+  // Every voxel of the faces' layer holds the product of its faces' shares (coverage of an
+  // axis-aligned box; 0.02: the voxelizer's supersampled coverage is quantised) times the value.
+  for (int z = lo.z; z <= hi.z; ++z)
+    for (int y = lo.y; y <= hi.y; ++y)
+      for (int x = lo.x; x <= hi.x; ++x) {
+        if (inner(x, y, z)) continue;
+        const std::size_t v = grid.index(x, y, z);
+        if (!deepAir(v)) continue;
+        const glm::ivec3 p(x, y, z);
+        double expected = 1.0;
+        for (int axis = 0; axis < 3; ++axis)
+          expected *= p[axis] == lo[axis] ? share_lo[axis] : p[axis] == hi[axis] ? share_hi[axis] : 1.0;
+        const double f = share(v);
+        if (std::abs(f - expected) > 0.02 || !proportional(v, f)) return std::nullopt;
+      }
+  AirMedium box;
+  const glm::dvec3 voxel = grid.voxelSize();
+  box.lo = grid.bounds_min + (glm::dvec3(lo) + 1.0 - share_lo) * voxel;
+  box.hi = grid.bounds_min + (glm::dvec3(hi) + share_hi) * voxel;
+  box.sigma_a = glm::dvec3(c);
+  box.scatter = glm::dvec2(c.w, c.w > 0.0 ? g : 0.0);
+  return box;
+}
+
+double boxShare(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& lo, const glm::dvec3& hi) {
+  double enter = 0.0, leave = 1.0;
+  for (int k = 0; k < 3; ++k) {
+    const double d = b[k] - a[k];
+    if (d == 0.0) {
+      if (a[k] < lo[k] || a[k] > hi[k]) return 0.0;
+      continue;
+    }
+    const double t0 = (lo[k] - a[k]) / d, t1 = (hi[k] - a[k]) / d;
+    enter = std::max(enter, std::min(t0, t1));
+    leave = std::min(leave, std::max(t0, t1));
+  }
+  return std::max(leave - enter, 0.0);
+}
+
 InterfaceTable interfaceTable(const Volume& volume, const std::string& source) {
   InterfaceTable table;
   const bool has_field = volume.has("interfaces");

@@ -78,6 +78,26 @@ struct MaterialValues {
 };
 MaterialValues deepMaterialValues(const Volume& volume, const InterfaceTable& table, const Field& field, double depth,
                                   bool with_air = true);
+// Air whose σa and scattering are one constant inside a box and 0 outside it: smoke around the
+// objects (n = 1, so no slot of its own; the amber bunny's). The deep air voxels (as above) inside
+// the box of those that are not 0 all hold one value; those in its faces' layer a share f of it
+// (the part of the voxel the smoke covers: voxelize blends by coverage; an axis-aligned box's edges
+// the product of two faces' shares) with the same g; each face lies where its voxels' share puts
+// it, 1 − f of a voxel in from the layer's outer side. Then a straight path in air from a to b is
+// in the smoke for boxShare(a, b, lo, hi) of its length: the viewer's march (viewer/volume_analysis.h
+// slotMedia) and the bake (lightsim VolumeSampler::absorptionPerMaterial) take the smoke's
+// constants over that share, and the smoke ends at its faces as a material ends at its surface.
+struct AirMedium {
+  glm::dvec3 lo{0.0}, hi{0.0};  // the smoke's faces, volume coordinates
+  glm::dvec3 sigma_a{0.0};
+  glm::dvec2 scatter{0.0};      // albedo ω̂, Henyey–Greenstein g
+};
+// nullopt where the air's σa and ω̂ are not one box of one value, or are 0 throughout. `depth` in
+// world units, as for deepMaterialValues.
+std::optional<AirMedium> airMediumBox(const Volume& volume, const InterfaceTable& table, double depth);
+// The share of the segment a → b inside the box [lo, hi] (slabs), in [0, 1].
+double boxShare(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& lo, const glm::dvec3& hi);
+
 // The depth, in (smallest) voxel edges, beyond which a voxel is deep inside its material: a voxel
 // cube's corners lie √3/2 edges from its centre, so nothing of another object is blended in.
 constexpr double kDeepVoxels = 1.0;

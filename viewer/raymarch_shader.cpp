@@ -212,7 +212,7 @@ std::string slotMediumDefines(const SlotMedia& media) {
     // The air's medium is the smoke's, over the share of each step inside its box (mediumShare@).
     SlotMedia boxed = media;
     boxed.air_box.reset();
-    boxed.media[0] = media.air_box->inside;
+    boxed.media[0] = MaterialMedium{media.air_box->sigma_a, media.air_box->scatter};
     auto vec3Of = [&](const glm::dvec3& v) { return "vec3(" + number(v.x) + ", " + number(v.y) + ", " + number(v.z) + ")"; };
     return slotMediumDefines(boxed) + "#define AIR_BOX 1\n#define AIR_BOX_MIN " + vec3Of(media.air_box->lo) +
            "\n#define AIR_BOX_MAX " + vec3Of(media.air_box->hi) + "\n";

@@ -716,7 +716,7 @@ TEST_F(SharpViewerTest, ConstantMediaScatterAndAbsorbAsTheClosedFormSays) {
 // Smoke in a box around a glass ball (the amber bunny's setting: the smoke has n = 1, no surface of
 // its own), under a uniform baked light E along l, black sky, seen along −z beside the ball. The
 // march takes the smoke's σa and ω̂ as constants over the share of each step inside its box
-// (viewer/volume_analysis.h AirBox). Closed form (Eq. 5.10 with Eq. 3.4, 5.7; no surface on the
+// (core/interfaces.h airMediumBox). Closed form (Eq. 5.10 with Eq. 3.4, 5.7; no surface on the
 // way): L = ω̂·p·E·(1 − e^(−σ·d))/σ, d = 0.77 the box's depth, its faces off the voxel lattice.
 TEST_F(SharpViewerTest, SmokeInABoxScattersAndAbsorbsAsTheClosedFormSays) {
   const glm::dvec3 sigma(0.5, 2.0, 4.0);

@@ -54,28 +54,16 @@ struct MaterialMedium {
   glm::dvec3 sigma_a{0.0};
   glm::dvec2 scatter{0.0};  // albedo ω̂, Henyey–Greenstein g
 };
-// Air whose σa and ω̂ are one constant inside a box and 0 outside it: smoke around the objects
-// (the amber bunny's). Deep air voxels (as above) inside the box of those that are not 0 all hold
-// one value; those in its faces' layer hold a share f of it (the part of the voxel the smoke
-// covers: voxelize blends by coverage) with the same g; every face lies where its voxels' share
-// puts it, 1 − f of a voxel in from the layer's outer side. The march then takes the air's medium
-// as `inside` times the share of each step that lies in the box (object.glsl, AIR_BOX): no fetch,
-// and the smoke ends at the box's faces as a slot's medium ends at its surface.
-struct AirBox {
-  glm::dvec3 lo{0.0}, hi{0.0};  // the smoke's faces, volume coordinates
-  MaterialMedium inside;
-};
 struct SlotMedia {
   bool sigma_a_constant = false;      // σa is one constant in every material
   bool scatter_constant = false;      // ω̂ and g likewise
   std::vector<MaterialMedium> media;  // [0] air (outside air_box where there is one), [1 + k] slot k
-  std::optional<AirBox> air_box;      // with both constants: the air's are these inside the box
+  std::optional<AirMedium> air_box;   // with both constants: the air's are these inside the box
 };
 // Both false for a volume without sharp interfaces. A field the volume lacks is constant (0).
-// Where the air alone varies, and as a box of smoke (AirBox), both are true with air_box set.
+// Where the air alone varies, as a box of smoke (core/interfaces.h airMediumBox), both are true
+// with air_box set: the march takes the air's medium over the share of each step inside the box
+// (object.glsl, AIR_BOX).
 SlotMedia slotMedia(const Volume& volume, const InterfaceTable& table);
-// The box of smoke in the air, where the air's σa and ω̂ are one as above (nullopt where they are
-// not, or are 0 throughout). `depth`: as for slotMedia, in world units.
-std::optional<AirBox> airMediumBox(const Volume& volume, const InterfaceTable& table, double depth);
 
 }  // namespace eik

@@ -362,9 +362,9 @@ TEST(AirMediumBox, IsTheSmokesBoxWithItsFacesWhereTheirCoverageSays) {
       EXPECT_NEAR(media.air_box->lo[c], lo[c], 1e-6) << res << " lo " << c;
       EXPECT_NEAR(media.air_box->hi[c], hi[c], 1e-6) << res << " hi " << c;
     }
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(media.air_box->inside.sigma_a[c], glm::dvec3(0.5, 2, 4)[c], 1e-6);
-    EXPECT_NEAR(media.air_box->inside.scatter.x, 0.6, 1e-6);
-    EXPECT_NEAR(media.air_box->inside.scatter.y, 0.4, 1e-6);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(media.air_box->sigma_a[c], glm::dvec3(0.5, 2, 4)[c], 1e-6);
+    EXPECT_NEAR(media.air_box->scatter.x, 0.6, 1e-6);
+    EXPECT_NEAR(media.air_box->scatter.y, 0.4, 1e-6);
     EXPECT_EQ(media.media[0].sigma_a, glm::dvec3(0.0)) << "outside the box the air is clear";
     EXPECT_EQ(media.media[0].scatter, glm::dvec2(0.0));
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(media.media[1].sigma_a[c], glm::dvec3(0.25, 0.5, 1)[c], 1e-6);

@@ -463,18 +463,11 @@ void followBoundaryLayer@(inout Ray r, inout March@ m, vec3 grad, float grad2, b
 }
 
 // The share of the straight stretch a → b (volume coordinates) that the air's medium fills: with
-// smoke in a box (AIR_BOX, viewer/volume_analysis.h AirBox; MEDIUM_SIGMA_A and MEDIUM_SCATTER give
+// smoke in a box (AIR_BOX, core/interfaces.h airMediumBox; MEDIUM_SIGMA_A and MEDIUM_SCATTER give
 // the air's inside it) the part of a → b in the box (slabs), else all of it.
 float mediumShare@(March@ m, vec3 a, vec3 b) {
 #ifdef AIR_BOX
-  if (m.medium >= 0) return 1.0;
-  vec3 d = b - a;
-  vec3 inv = 1.0 / mix(vec3(1e-30), d, greaterThan(abs(d), vec3(1e-30)));
-  vec3 t0 = (AIR_BOX_MIN - a) * inv, t1 = (AIR_BOX_MAX - a) * inv;
-  vec3 tNear = min(t0, t1), tFar = max(t0, t1);
-  float enter = clamp(max(max(tNear.x, tNear.y), tNear.z), 0.0, 1.0);
-  float leave = clamp(min(min(tFar.x, tFar.y), tFar.z), 0.0, 1.0);
-  return max(leave - enter, 0.0);
+  return m.medium >= 0 ? 1.0 : boxShare(a, b, AIR_BOX_MIN, AIR_BOX_MAX);
 #else
   return 1.0;
 #endif
