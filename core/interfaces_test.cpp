@@ -150,5 +150,18 @@ TEST(Interfaces, TheMaterialIsTheFirstSlotWithANegativeDistance) {
   EXPECT_EQ(materialSlot({-0.1, -0.2, 0.3, 0.4}, 4), 0);
 }
 
+// The share of a segment inside a box: the slabs' overlap of the segment's parameter range.
+TEST(BoxShare, IsThePartOfTheSegmentInsideTheBox) {
+  const glm::dvec3 lo(0.0), hi(1.0, 2.0, 3.0);
+  EXPECT_DOUBLE_EQ(boxShare({0.2, 0.5, 1.0}, {0.8, 1.5, 2.0}, lo, hi), 1.0);    // inside
+  EXPECT_DOUBLE_EQ(boxShare({2.0, 0.5, 1.0}, {3.0, 1.5, 2.0}, lo, hi), 0.0);    // beside it
+  EXPECT_DOUBLE_EQ(boxShare({-1.0, 1.0, 1.0}, {1.0, 1.0, 1.0}, lo, hi), 0.5);   // in through a face
+  EXPECT_DOUBLE_EQ(boxShare({-1.0, 1.0, 1.0}, {2.0, 1.0, 1.0}, lo, hi), 1.0 / 3.0);  // through it
+  EXPECT_NEAR(boxShare({-0.5, -1.0, 1.5}, {1.5, 3.0, 1.5}, lo, hi), 0.5, 1e-15);  // diagonal: x and y cut it
+  EXPECT_DOUBLE_EQ(boxShare({0.5, 3.0, 1.0}, {0.5, 3.0, 2.0}, lo, hi), 0.0);    // parallel, outside in y
+  EXPECT_DOUBLE_EQ(boxShare({0.5, 1.0, 1.0}, {0.5, 1.0, 1.0}, lo, hi), 1.0);    // a point: in or out
+  EXPECT_DOUBLE_EQ(boxShare({1.5, 1.0, 1.0}, {1.5, 1.0, 1.0}, lo, hi), 0.0);
+}
+
 }  // namespace
 }  // namespace eik

@@ -132,7 +132,7 @@ StepContext makeStepContext(const VolumeSampler& sampler, const SimulationOption
 
 bool tornLightPassesToReceiver(const VolumeSampler& sampler, const SimulationOptions& options) {
   return options.receiver.has_value() && !options.on_leave &&
-         (!sampler.hasAbsorption() || sampler.absorptionPerMaterial());
+         (!sampler.hasAbsorption() || (sampler.absorptionPerMaterial() && !sampler.airBox()));
 }
 
 PatchStepResult stepPatch(Patch& patch, const StepContext& ctx) {
@@ -503,7 +503,7 @@ PatchStepResult stepPatch(Patch& patch, PatchSamples& samples, const StepContext
       optical_depth = sampler.sigmaA(m_old) * ds;
     } else if (flight > 0.0) {
       for (int c = 0; c < 4; ++c)
-        optical_depth += 0.25 * sampler.materialSigmaA(patch.medium[c]) * (flight / samples.corner[c].x);
+        optical_depth += 0.25 * sampler.pieceOpticalDepth(patch.medium[c], before.x[c], patch.x[c], flight / samples.corner[c].x);
     }
     const glm::dvec3 transmitted = glm::exp(-optical_depth);
     result.absorbed = patch.flux * (1.0 - transmitted);

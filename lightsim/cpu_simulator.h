@@ -131,7 +131,7 @@ StepContext makeStepContext(const VolumeSampler& sampler, const SimulationOption
 // Whether a patch torn at the depth limit gives the receiver the light its corners carry past the
 // object (ALGORITHM.md "Sharp interfaces"; stepPatch's passingShare, analysis.frag's): with a
 // receiver, not in a scene's chain of boxes (on_leave: that light may meet another object), and
-// not where σa is a field only (the air may absorb along the way).
+// not where σa is a field only or the air holds smoke (the air may absorb along the way).
 bool tornLightPassesToReceiver(const VolumeSampler& sampler, const SimulationOptions& options);
 
 PatchStepResult stepPatch(Patch& patch, const StepContext& context);

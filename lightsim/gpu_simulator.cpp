@@ -103,12 +103,26 @@ struct GpuSimulator::Impl {
         volume(uploadVolume(v, o)),
         volumeDefines(volume.layout().glslDefines() + (o.exact_sampling ? "#define EXACT_TRILINEAR 1\n" : "") +
                       (sharp ? "#define SHARP_INTERFACES 1\n" : "") +
-                      (sampler.absorptionPerMaterial() ? "#define MATERIAL_ABSORPTION 1\n" : "")),
+                      (sampler.absorptionPerMaterial() ? "#define MATERIAL_ABSORPTION 1\n" : "") +
+                      airBoxDefines(sampler, 0.5 * (grid.bounds_min + grid.bounds_max))),
         origin(0.5 * (grid.bounds_min + grid.bounds_max)),
         gridUniforms(gpu::GridUniforms::from(localGrid(grid, origin), interfaceTable(v, o.source))) {
     if (sampler.absorptionPerMaterial())
       for (int k = 0; k < gridUniforms.slotCount; ++k)
         gridUniforms.slotSigmaA[static_cast<std::size_t>(k)] = glm::vec3(sampler.materialSigmaA(k));
+  }
+
+  // The smoke's box (VolumeSampler::airBox) in grid-local coordinates, and its σa (sharp.glsl).
+  static std::string airBoxDefines(const VolumeSampler& sampler, const glm::dvec3& origin) {
+    if (!sampler.absorptionPerMaterial() || !sampler.airBox()) return "";
+    auto vec3Of = [](const glm::dvec3& v) {
+      char text[96];
+      std::snprintf(text, sizeof text, "vec3(%.9g, %.9g, %.9g)", v.x, v.y, v.z);
+      return std::string(text);
+    };
+    const AirMedium& air = *sampler.airBox();
+    return "#define AIR_BOX 1\n#define AIR_BOX_LO " + vec3Of(air.lo - origin) + "\n#define AIR_BOX_HI " +
+           vec3Of(air.hi - origin) + "\n#define AIR_SIGMA_A " + vec3Of(air.sigma_a) + "\n";
   }
 
   static GridSpec localGrid(GridSpec g, const glm::dvec3& origin) {

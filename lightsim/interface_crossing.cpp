@@ -147,7 +147,7 @@ CornerCrossings advanceCornerSharp(glm::dvec3& x, glm::dvec3& w, int& medium, gl
   const bool absorbing = sampler.absorptionPerMaterial();
   // Beer–Lambert along one straight piece in `medium`.
   auto absorb = [&](const glm::dvec3& from, const glm::dvec3& to) {
-    if (absorbing) result.optical_depth += sampler.materialSigmaA(medium) * glm::length(to - from);
+    if (absorbing) result.optical_depth += sampler.pieceOpticalDepth(medium, from, to, glm::length(to - from));
   };
   double remaining = dt;
   for (int crossing = 0; crossing <= kMaxCrossingsPerStep && remaining > 0.0; ++crossing) {

@@ -261,8 +261,15 @@ VolumeSampler::VolumeSampler(const Volume& volume, std::vector<float>* interface
 void VolumeSampler::findMaterialAbsorption(const Volume& volume) {
   const Field* sigma = volume.find("sigma_a");
   if (!sharp() || sigma_a_.empty() || !sigma) return;
-  const MaterialValues deep = deepMaterialValues(volume, table_, *sigma, kDeepVoxels * h_);
-  if (!deep.one_value || (deep.seen[0] && deep.value[0] != glm::dvec3(0.0))) return;  // σa in the air
+  MaterialValues deep = deepMaterialValues(volume, table_, *sigma, kDeepVoxels * h_);
+  if (!deep.one_value || (deep.seen[0] && deep.value[0] != glm::dvec3(0.0))) {
+    // σa in the air: per material still where it is one box of smoke (airMediumBox).
+    std::optional<AirMedium> air = airMediumBox(volume, table_, kDeepVoxels * h_);
+    if (!air) return;
+    deep = deepMaterialValues(volume, table_, *sigma, kDeepVoxels * h_, false);
+    if (!deep.one_value) return;
+    air_ = air;
+  }
   // Each transparent material's σa: the one the voxelizer recorded in the slot table, which its deep
   // voxels must agree with; else that of its deep voxels. A material with neither (a wall thinner
   // than two voxels in a volume from before the table held σa) leaves σa to the field.
@@ -272,11 +279,15 @@ void VolumeSampler::findMaterialAbsorption(const Volume& volume) {
     if (opaque(k)) {
       slot_sigma_a_[s] = glm::dvec3(0.0);
     } else if (recorded) {
-      if (deep.seen[m] && glm::vec3(deep.value[m]) != glm::vec3(*recorded)) return;
+      if (deep.seen[m] && glm::vec3(deep.value[m]) != glm::vec3(*recorded)) {
+        air_.reset();
+        return;
+      }
       slot_sigma_a_[s] = *recorded;
     } else if (deep.seen[m]) {
       slot_sigma_a_[s] = deep.value[m];
     } else {
+      air_.reset();
       return;
     }
   }

@@ -122,12 +122,23 @@ class VolumeSampler {
   // interfaces"): true when each transparent material has one σa — the slot table's `sigma_a`, or
   // else the field's at its deep voxels (core/interfaces.h deepMaterialValues; the field's ramp
   // across a surface is the voxelizer's coverage blend) — which agrees with the field at every deep
-  // voxel, and σa = 0 at those in air. Then σa at a point is its material's, and a ray's
-  // absorbing length ends on the interface itself, not on the field's ramp (exact Beer–Lambert).
+  // voxel, and σa = 0 at those in air — or the air's σa is one box of smoke (core/interfaces.h
+  // airMediumBox: airBox()). Then σa at a point is its material's, and a ray's absorbing length
+  // ends on the interface itself (and on the smoke's faces), not on the field's ramp (exact
+  // Beer–Lambert).
   bool absorptionPerMaterial() const { return absorption_per_material_; }
-  // σa of material `slot` (−1: air, 0); meaningful when absorptionPerMaterial().
+  // σa of material `slot` (−1: air: 0, or the smoke's inside its box); meaningful when
+  // absorptionPerMaterial().
   glm::dvec3 materialSigmaA(int slot) const {
-    return slot >= 0 ? slot_sigma_a_[static_cast<std::size_t>(slot)] : glm::dvec3(0.0);
+    return slot >= 0 ? slot_sigma_a_[static_cast<std::size_t>(slot)] : air_ ? air_->sigma_a : glm::dvec3(0.0);
+  }
+  // The smoke in the air where absorptionPerMaterial() found one.
+  const std::optional<AirMedium>& airBox() const { return air_; }
+  // ∫σa ds along the straight piece a → b of `length` in material `slot` (absorptionPerMaterial):
+  // σa·length, in air only the share of it inside the smoke's box.
+  glm::dvec3 pieceOpticalDepth(int slot, const glm::dvec3& a, const glm::dvec3& b, double length) const {
+    const glm::dvec3 tau = materialSigmaA(slot) * length;
+    return slot < 0 && air_ ? tau * boxShare(a, b, air_->lo, air_->hi) : tau;
   }
 
   // Sharp interfaces (core/interfaces.h); an empty table and slot −1 everywhere without them.
@@ -161,6 +172,7 @@ class VolumeSampler {
   std::vector<glm::vec3> sigma_a_;   // empty: no absorption
   bool absorption_per_material_ = false;
   std::array<glm::dvec3, kMaxInterfaceSlots> slot_sigma_a_{};
+  std::optional<AirMedium> air_;
   void findMaterialAbsorption(const Volume& volume);
   InterfaceTable table_;
   std::vector<glm::vec4> distances_; // empty without sharp interfaces or with used_distances_

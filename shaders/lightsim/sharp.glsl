@@ -14,7 +14,21 @@ uniform int uSlotGraded;  // bit k: slot k takes n and ∇n from the ior / ior_g
 uniform int uSlotOpaque;  // bit k: slot k stops light
 #ifdef MATERIAL_ABSORPTION
 uniform vec3 uSlotSigmaA[4];  // σa per material (VolumeSampler::absorptionPerMaterial)
+#ifdef AIR_BOX
+// Smoke in the air (core/interfaces.h airMediumBox; AIR_BOX_LO, AIR_BOX_HI grid-local, AIR_SIGMA_A).
+#include "common/box.glsl"
+vec3 materialSigmaA(int slot) { return slot >= 0 ? uSlotSigmaA[slot] : AIR_SIGMA_A; }
+#else
 vec3 materialSigmaA(int slot) { return slot >= 0 ? uSlotSigmaA[slot] : vec3(0.0); }
+#endif
+// ∫σa ds along the straight piece a → b of `len` in material `slot`: in air only the share of it
+// inside the smoke's box (VolumeSampler::pieceOpticalDepth).
+vec3 pieceOpticalDepth(int slot, vec3 a, vec3 b, float len) {
+#ifdef AIR_BOX
+  if (slot < 0) return AIR_SIGMA_A * (len * boxShare(a, b, AIR_BOX_LO, AIR_BOX_HI));
+#endif
+  return materialSigmaA(slot) * len;
+}
 #endif
 
 // The slot distances d_k at x (trilinear, clamp to edge; unused slots read +band).
@@ -215,7 +229,7 @@ CornerCrossings advanceCornerSharp(inout vec3 x, inout vec3 w, inout int medium,
     int slot, entered;
     if (crossing == kMaxCrossingsPerStep || !findInterfaceOnChord(x, x1, medium, f, slot, entered) || entered == medium) {
 #ifdef MATERIAL_ABSORPTION
-      result.opticalDepth += materialSigmaA(medium) * distance(x, x1);
+      result.opticalDepth += pieceOpticalDepth(medium, x, x1, distance(x, x1));
 #endif
       x = x1;
       w = normalize(w1) * materialOptics(medium, x).x;  // |w| = n (ALGORITHM.md step 1)
@@ -224,7 +238,7 @@ CornerCrossings advanceCornerSharp(inout vec3 x, inout vec3 w, inout int medium,
     vec3 p = x + f * (x1 - x);
     remaining *= 1.0 - f;
 #ifdef MATERIAL_ABSORPTION
-    result.opticalDepth += materialSigmaA(medium) * distance(x, p);
+    result.opticalDepth += pieceOpticalDepth(medium, x, p, distance(x, p));
 #endif
     x = p;
     vec3 normal = interfaceNormal(slot, p);

@@ -139,9 +139,10 @@ void main() {
   if (flight > 0.0) {
     for (int c = 0; c < 4; ++c) {
       float n = materialOptics(p.medium[c], p.x[c]).x;
+      vec3 from = p.x[c];
       p.x[c] += flight * p.w[c] / (n * n);  // Eq. 6.1, exact for a straight ray
 #ifdef MATERIAL_ABSORPTION
-      opticalDepth += 0.25 * materialSigmaA(p.medium[c]) * (flight / n);
+      opticalDepth += 0.25 * pieceOpticalDepth(p.medium[c], from, p.x[c], flight / n);
 #endif
     }
   } else {
