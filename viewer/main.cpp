@@ -4,7 +4,7 @@
 //          [--camera EX,EY,EZ:TX,TY,TZ:FOVY_DEG] [--env FILE | uniform:R,G,B | checker[:R,G,B] | sky]
 //          [--step VOXELS] [--integrator euler|rk4] [--no-refraction] [--no-fresnel] [--no-scattering]
 //          [--no-attenuation] [--no-emission] [--no-dispersion] [--no-ground] [--no-skip]
-//          [--no-reflect-objects] [--bands N]
+//          [--no-reflect-objects] [--bands N] [--every-band]
 //
 //   viewer SCENE.json | VOLUME.vol.json            (no --render: the interactive window, viewer/window.h)
 //          [--window-frames N --save OUT.exr|OUT.png ...]   (scripted window, for tests)
@@ -87,6 +87,10 @@ int run(int argc, char** argv) {
                  "spectral bands of the dispersion, 3 (R, G, B) or 4..16 weighted by the CIE 1931 functions, as "
                  "lightsim --bands (default: the bands the objects were baked with, else 3)")
       ->check(CLI::Range(3, 16));
+  bool every_band = false;
+  app.add_flag("--every-band", every_band,
+               "with 4..16 bands, trace every band (default: trace the spectrum's two ends and interpolate the "
+               "bands between them where both took the same way through the glass)");
   app.add_flag("--no-ground", no_ground, "leave out the scene's ground plane");
   app.add_flag("--no-reflect-objects", no_reflect_objects,
                "reflections see the ground and the environment only (default: the first reflection off an "
@@ -220,6 +224,7 @@ int run(int argc, char** argv) {
     if (const auto it = object.volume.metadata.find("bake_bands"); it != object.volume.metadata.end() && it->is_number_integer())
       settings.bands = std::clamp(std::max(settings.bands, it->get<int>()), 3, 16);
   if (app.count("--bands")) settings.bands = bands;
+  settings.interpolate_bands = !every_band;
   settings.ground = !no_ground;
   settings.reflect_objects = !no_reflect_objects;
   settings.skip_empty_space = !no_skip;

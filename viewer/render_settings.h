@@ -37,6 +37,9 @@ struct RenderSettings {
   // R, G and B at 0.61, 0.55, 0.465 µm; 4 … 16 trace that many bands over 0.38 – 0.78 µm, each
   // weighted by its CIE share of R, G and B (where the draw target has a depth buffer; else 3).
   int bands = 3;
+  // With 4 … 16 bands: trace the spectrum's two end bands and interpolate the others' rays between
+  // them where the two took the same way (raymarch.frag spectralBand); off: trace every band.
+  bool interpolate_bands = true;
   bool ground = true;        // the scene's ground plane, if it has one
   // One bounce through the scene: the first reflection off an object's outside is traced as a ray
   // of its own through the other objects and onto the ground (off: it sees the ground and the

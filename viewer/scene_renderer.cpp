@@ -338,6 +338,7 @@ struct SceneRenderer::Impl {
     if (p.hasUniform("uBandCount")) {  // DISPERSION_BANDS
       const std::vector<SpectralBand> bands = spectralBands(settings.bands);
       p.set("uBandCount", static_cast<int>(bands.size()));
+      p.set("uInterpolateBands", settings.interpolate_bands ? 1 : 0);
       for (std::size_t b = 0; b < bands.size(); ++b) {
         const std::string index = "[" + std::to_string(b) + "]";
         const double lambda = bands[b].lambda_um;

@@ -118,7 +118,8 @@ bool sameControls(const RenderSettings& a, const RenderSettings& b) {
   return a.step_voxels == b.step_voxels && a.integrator == b.integrator && a.refraction == b.refraction &&
          a.scattering == b.scattering && a.fresnel == b.fresnel && a.attenuation == b.attenuation &&
          a.emission == b.emission && a.dispersion == b.dispersion && a.ground == b.ground &&
-         a.skip_empty_space == b.skip_empty_space && a.reflect_objects == b.reflect_objects;
+         a.skip_empty_space == b.skip_empty_space && a.reflect_objects == b.reflect_objects &&
+         a.interpolate_bands == b.interpolate_bands;
 }
 
 }  // namespace
@@ -302,6 +303,10 @@ int runViewerWindow(const LoadedScene& scene, const RenderSettings& initial_sett
       ImGui::Checkbox("emission", &wanted.emission);
       ImGui::SameLine();
       ImGui::Checkbox("dispersion", &wanted.dispersion);
+      if (wanted.bands > 3) {  // trace the spectrum's ends and interpolate (off: trace every band)
+        ImGui::SameLine();
+        ImGui::Checkbox("interpolate bands", &wanted.interpolate_bands);
+      }
       ImGui::Checkbox("ground", &wanted.ground);
       ImGui::SameLine();
       ImGui::Checkbox("reflect objects", &wanted.reflect_objects);

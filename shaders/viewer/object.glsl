@@ -362,6 +362,7 @@ bool reflectedAtSharpFace@(inout Ray r, inout March@ m) {
 #ifdef SHARP_FACES
   if (m.n > 1.0 + 1e-3 && (any(lessThan(m.x, m.bmin)) || any(greaterThan(m.x, uObjBoundsMax[@])))) {
     vec3 outward = normalize(step(uObjBoundsMax[@], m.x) - step(m.x, m.bmin));
+    gSurfaceCode = surfaceCode(outward);
     vec3 dir = normalize(m.w);
     // Back onto the face the step crossed (the first one along the step).
     vec3 face = mix(m.bmin, uObjBoundsMax[@], step(0.0, outward));
@@ -704,6 +705,7 @@ bool crossInterface@(inout Ray r, inout March@ m, float cauchy) {
     m.stopped = true;
     return true;
   }
+  gSurfaceCode = dot(normal, normal) == 0.0 ? 0u : surfaceCode(normalize(normal));
   if (dot(normal, normal) == 0.0) {
     m.medium = entered;
     m.n = refractiveIndex@(uvw, cauchy, entered).r;
@@ -820,8 +822,11 @@ void march@(inout Ray r, float cauchy) {
     }
     if (event == EVENT_OPAQUE) { shadeOpaque@(r, m); break; }
     ++steps;  // the step that ended the run, or the one a reflection takes again
-    if (event == EVENT_LEFT && !reflectedAtSharpFace@(r, m)) break;  // total internal reflection: on
-    if (event == EVENT_CROSSING && (crossInterface@(r, m, cauchy) || absorbed@(r, m))) break;
+    // Out of the box, or on from a total internal reflection at a face on its edge; a surface
+    // crossed or reflected at. The way records the event and the material it leaves the ray in.
+    bool stop = event == EVENT_LEFT ? !reflectedAtSharpFace@(r, m) : (crossInterface@(r, m, cauchy) || absorbed@(r, m));
+    r.path = ((r.path * 31u + uint(event)) * 31u + uint(m.medium + 2)) * 31u + gSurfaceCode;
+    if (stop) break;
   }
   leaveVolume@(r, m);
 }

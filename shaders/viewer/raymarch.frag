@@ -93,6 +93,8 @@ struct Ray {
   bool entered;   // went through a volume
   bool dispersed; // went through a volume with a dispersion field (DISPERSION: its path depends on λ)
   vec3 exitX;     // world position where it last left a volume
+  uint path;      // a hash of the objects it met and of each event on its way and the material it
+                  // left it in: two wavelengths with the same hash took the same way (DISPERSION_BANDS)
 };
 
 // Irradiance from the scene's lights at x on a surface of normal N, nothing in the way.
@@ -165,6 +167,14 @@ vec3 gBranchX = vec3(0.0);       // where it leaves (world) and where it goes (w
 vec3 gBranchD = vec3(0.0, 1.0, 0.0);
 int gBranchObject = -1;          // the object it leaves, which it does not meet again (convex)
 Ray gBranchRay;                  // the reflection once traced (done from the start when none)
+// The surface the last crossing or reflection met, coarsely: its normal's direction, each component
+// in three levels (below −⅓, between, above ⅓; surfaceCode): normals 55° or more apart never share a
+// code, so that a ray's way (Ray.path) tells an edge's two faces apart.
+uint gSurfaceCode = 0u;
+uint surfaceCode(vec3 normal) {
+  uvec3 level = uvec3(sign(normal) * step(1.0 / 3.0, abs(normal)) + 1.0);
+  return 1u + level.x + 3u * level.y + 9u * level.z;
+}
 uniform int uTraceLegs;          // 2: the primary ray and its reflection (a uniform: a loop the
                                  // compiler cannot unroll into two copies of what it calls)
 
@@ -174,6 +184,9 @@ uniform int uTraceLegs;          // 2: the primary ray and its reflection (a uni
 uniform int uBandCount;
 uniform float uBandCauchy[DISPERSION_BANDS];
 uniform vec3 uBandRgb[DISPERSION_BANDS];
+// 1: trace the spectrum's two end bands and interpolate the others' rays between them where the two
+// took the same way (RenderSettings::interpolate_bands); 0: trace every band.
+uniform int uInterpolateBands;
 #endif
 
 // Every object's march (march0, march1, ...): viewer/raymarch_shader.cpp puts one instance of
@@ -261,6 +274,7 @@ void trace(inout Ray r, float cauchy, int skip) {
 #endif
     bool ended = r.done || next < 0;
     if (!ended) {
+      r.path = r.path * 37u + uint(next + 1);
       r.x += tBest * r.d;
       marchObject(next, r, cauchy);
       ended = r.done;
@@ -321,18 +335,24 @@ Ray primaryRay() {
   r.entered = false;
   r.dispersed = false;
   r.exitX = uEye;
+  r.path = 0u;
   return r;
 }
 
-// The environment in the exit direction, at the mip level of the ray's footprint: refracted rays
-// diverge, so their pixel covers more of the map (dFdx/dFdy of the exit direction; call in uniform
-// control flow).
-vec3 finish(Ray r) {
+// The environment's mip level for the ray's footprint: refracted rays diverge, so their pixel
+// covers more of the map (dFdx/dFdy of the exit direction; call in uniform control flow).
+float exitLod(Ray r) {
   float spread = max(length(dFdx(r.d)), length(dFdy(r.d)));
-  float lod = envLod(max(spread, uPixelSpread)) + uEnvLodBias;
+  return envLod(max(spread, uPixelSpread)) + uEnvLodBias;
+}
+
+// The ray's radiance with the environment in its exit direction at level `lod`.
+vec3 finishAt(Ray r, float lod) {
   if (r.done) return r.radiance;
   return r.radiance + r.T * environmentRadiance(r.d, lod);
 }
+
+vec3 finish(Ray r) { return finishAt(r, exitLod(r)); }
 
 // A primary ray traced at one wavelength (its Cauchy term) and, with REFLECT_OBJECTS, the one
 // reflection it recorded, traced after it; finishShaded adds them (in uniform control flow: finish
@@ -364,17 +384,88 @@ Shaded traceShaded(float cauchy) {
   return s;
 }
 
-vec3 finishShaded(Shaded s) {
-  vec3 color = finish(s.r);
+// The reflection a primary ray recorded (REFLECT_OBJECTS), traced, with its environment at the
+// reflection lookups' level (its footprint is the surface's curvature's, which derivatives across
+// pixels of different branches do not give).
+vec3 branchColor(Shaded s) {
 #ifdef REFLECT_OBJECTS
-  // The reflection's environment at the reflection lookups' level (its footprint is the
-  // surface's curvature's, which derivatives across pixels of different branches do not give).
   vec3 branch = s.branch.radiance;
   if (!s.branch.done) branch += s.branch.T * environmentRadiance(s.branch.d, uReflectionLod);
-  color += s.weight * branch;
+  return s.weight * branch;
+#else
+  return vec3(0.0);
 #endif
+}
+
+vec3 finishShaded(Shaded s) { return finish(s.r) + branchColor(s); }
+
+#ifdef DISPERSION_BANDS
+// Whether two wavelengths' traces took the same way: through the same objects, with the same
+// events in the same order, each leaving the ray in the same material, and ending alike (on the
+// ground, in the environment, or stopped), their recorded reflections too. Along such a way the
+// ray is a smooth function of n(λ), so the bands between them are interpolated (spectralBand).
+bool samePath(Shaded a, Shaded b) {
+  return a.r.path == b.r.path && a.r.done == b.r.done && a.r.grounded == b.r.grounded &&
+         a.branch.path == b.branch.path && a.branch.done == b.branch.done;
+}
+
+// What a ray gathered on its way, without the ground it ended on (trace adds that last).
+vec3 gatheredOnTheWay(Ray r) {
+#ifdef GROUND
+  if (r.grounded) return r.radiance - r.groundWeight * groundRadiance(r.x);
+#endif
+  return r.radiance;
+}
+
+// Band b's place between the spectrum's violet end (band 0: 0) and its red end (1), in its Cauchy
+// term 1/λ² − 1/λ_d², in which n is linear.
+float bandFraction(int b) {
+  float span = uBandCauchy[uBandCount - 1] - uBandCauchy[0];
+  return span != 0.0 ? (uBandCauchy[b] - uBandCauchy[0]) / span : 0.0;
+}
+
+// The band at fraction t of the Cauchy term's way from the spectrum's violet end (a) to its red end
+// (b), both traced along one way (samePath): its ray's end, direction and transmittance
+// interpolated linearly in the Cauchy term (n is linear in it, and the ray is smooth in n), then
+// ended where it ends, on the ground's map or in the environment, as a traced ray is. What the ray
+// gathered on the way (reflections looked up inside the glass, emission, scattering) and the
+// reflection it recorded are interpolated as colours.
+vec3 spectralBand(Shaded a, Shaded b, vec3 gatheredA, vec3 gatheredB, float lodA, float lodB, float t) {
+  Ray r = a.r;
+  r.x = mix(a.r.x, b.r.x, t);
+  r.d = normalize(mix(a.r.d, b.r.d, t));
+  r.T = mix(a.r.T, b.r.T, t);
+  r.radiance = mix(gatheredA, gatheredB, t);
+#ifdef GROUND
+  r.groundWeight = mix(a.r.groundWeight, b.r.groundWeight, t);
+  if (r.grounded) r.radiance += r.groundWeight * groundRadiance(r.x);
+#endif
+  return finishAt(r, mix(lodA, lodB, t)) + mix(branchColor(a), branchColor(b), t);
+}
+
+// Bands i0 … i1 between a (traced at band i0) and b (traced at band ib ≥ i1), weighted by their
+// shares of R, G and B; each band's ray interpolated (spectralBand), its environment's level of
+// detail between the two's.
+vec3 spectralRun(Shaded a, Shaded b, int i0, int i1, int ib, float lodA, float lodB) {
+  vec3 gatheredA = gatheredOnTheWay(a.r), gatheredB = gatheredOnTheWay(b.r);
+  float c0 = uBandCauchy[i0], span = uBandCauchy[ib] - c0;
+  vec3 color = vec3(0.0);
+  for (int band = i0; band <= i1; ++band)
+    color += uBandRgb[band] * spectralBand(a, b, gatheredA, gatheredB, lodA, lodB, span != 0.0 ? (uBandCauchy[band] - c0) / span : 0.0);
   return color;
 }
+
+// Bands i0 … i1 between a (band i0) and b (band ib) where the two took different ways and the
+// bands between were not traced: blends of the two's colours.
+vec3 spectralBlend(Shaded a, Shaded b, int i0, int i1, int ib, float lodA, float lodB) {
+  vec3 colorA = finishAt(a.r, lodA) + branchColor(a), colorB = finishAt(b.r, lodB) + branchColor(b);
+  float c0 = uBandCauchy[i0], span = uBandCauchy[ib] - c0;
+  vec3 color = vec3(0.0);
+  for (int band = i0; band <= i1; ++band)
+    color += uBandRgb[band] * mix(colorA, colorB, span != 0.0 ? (uBandCauchy[band] - c0) / span : 0.0);
+  return color;
+}
+#endif
 
 void main() {
 #if defined(OUTPUT_EXIT_POSITION) || defined(OUTPUT_EXIT_DIRECTION)
@@ -398,12 +489,58 @@ void main() {
   gl_FragDepth = green.r.dispersed ? 0.0 : 1.0;
   outColor = vec4(finishShaded(green), 1.0);
 #elif defined(DISPERSION_RED_BLUE_PASS) && defined(DISPERSION_BANDS)
-  // N spectral bands, as lightsim --bands bakes them (core/spectrum.h spectralBands): each traced
-  // at its own n(λ_b) and weighted by its share of R, G and B (the shares sum to 1 per channel), in
-  // every channel (SceneRenderer::draw unmasks green for this pass). A loop on a uniform bound:
-  // one copy of the trace in the program.
+  // N spectral bands, as lightsim --bands bakes them (core/spectrum.h spectralBands): each at its
+  // own n(λ_b) and weighted by its share of R, G and B (the shares sum to 1 per channel), in every
+  // channel (SceneRenderer::draw unmasks green for this pass). Not every band is traced
+  // (docs/physics.md "Dispersion in spectral bands"): the spectrum's two ends are, and where they
+  // took one way through the glass (samePath) the bands between are interpolated (spectralRun).
+  // Where they did not (a ray that meets one face of an edge in violet and the other in red), the
+  // band where violet's way ends is found by bisection, one trace a halving, and each side is
+  // interpolated; a red side that changes way again (a ray grazing an edge) is blended as colours
+  // (spectralBlend). 2 traces, at most 2 + log₂ N. With uInterpolateBands 0 every band is traced.
+  // One loop on a uniform bound, with one call of the trace: one copy of it in the program. Every
+  // lane runs the first two turns, so the environment's levels of detail are taken there, from the
+  // ends' directions, for all bands.
   vec3 color = vec3(0.0);
-  for (int b = 0; b < uBandCount; ++b) color += uBandRgb[b] * finishShaded(traceShaded(uBandCauchy[b]));
+  Shaded violet, red, onViolets, offViolets;  // the ends; the last band known on violet's way
+  int iOn = 0, iOff = uBandCount - 1;         // (iOn) and the first known off it (iOff)
+  float lodViolet = 0.0, lodRed = 0.0;
+  bool interpolating = uInterpolateBands != 0 && uBandCount >= 4;
+  bool searched = false;
+  for (int turn = 0; turn < uBandCount && !searched; ++turn) {
+    int band = !interpolating ? turn : (turn == 0 ? 0 : (turn == 1 ? uBandCount - 1 : (iOn + iOff) / 2));
+    Shaded s = traceShaded(uBandCauchy[band]);
+    if (!interpolating) {
+      color += uBandRgb[band] * finishShaded(s);
+      continue;
+    }
+    if (turn == 0) {
+      violet = onViolets = s;
+      lodViolet = exitLod(s.r);
+      continue;
+    }
+    if (turn == 1) {
+      red = offViolets = s;
+      lodRed = exitLod(s.r);
+    } else if (samePath(violet, s)) {
+      onViolets = s;
+      iOn = band;
+    } else {
+      offViolets = s;
+      iOff = band;
+    }
+    searched = samePath(violet, red) || iOff - iOn <= 1;
+  }
+  if (interpolating) {
+    if (samePath(violet, red)) {
+      color = spectralRun(violet, red, 0, uBandCount - 1, uBandCount - 1, lodViolet, lodRed);
+    } else {
+      float lodOn = mix(lodViolet, lodRed, bandFraction(iOn)), lodOff = mix(lodViolet, lodRed, bandFraction(iOff));
+      color = spectralRun(violet, onViolets, 0, iOn, iOn, lodViolet, lodOn);
+      color += samePath(offViolets, red) ? spectralRun(offViolets, red, iOff, uBandCount - 1, uBandCount - 1, lodOff, lodRed)
+                                         : spectralBlend(offViolets, red, iOff, uBandCount - 1, uBandCount - 1, lodOff, lodRed);
+    }
+  }
   outColor = vec4(color, 1.0);
 #elif defined(DISPERSION_RED_BLUE_PASS)
   Shaded red = traceShaded(cauchy[0]);
