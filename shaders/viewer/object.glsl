@@ -825,7 +825,9 @@ void march@(inout Ray r, float cauchy) {
     // Out of the box, or on from a total internal reflection at a face on its edge; a surface
     // crossed or reflected at. The way records the event and the material it leaves the ray in.
     bool stop = event == EVENT_LEFT ? !reflectedAtSharpFace@(r, m) : (crossInterface@(r, m, cauchy) || absorbed@(r, m));
-    r.path = ((r.path * 31u + uint(event)) * 31u + uint(m.medium + 2)) * 31u + gSurfaceCode;
+    recordWay(r, uint(event));
+    recordWay(r, uint(m.medium + 2));
+    recordWay(r, gSurfaceCode);
     if (stop) break;
   }
   leaveVolume@(r, m);

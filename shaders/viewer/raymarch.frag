@@ -175,6 +175,12 @@ uint surfaceCode(vec3 normal) {
   uvec3 level = uvec3(sign(normal) * step(1.0 / 3.0, abs(normal)) + 1.0);
   return 1u + level.x + 3u * level.y + 9u * level.z;
 }
+// Adds `code` to the ray's way (Ray.path): read only by DISPERSION_BANDS, nothing elsewhere.
+void recordWay(inout Ray r, uint code) {
+#ifdef DISPERSION_BANDS
+  r.path = r.path * 31u + code;
+#endif
+}
 uniform int uTraceLegs;          // 2: the primary ray and its reflection (a uniform: a loop the
                                  // compiler cannot unroll into two copies of what it calls)
 
@@ -274,7 +280,7 @@ void trace(inout Ray r, float cauchy, int skip) {
 #endif
     bool ended = r.done || next < 0;
     if (!ended) {
-      r.path = r.path * 37u + uint(next + 1);
+      recordWay(r, uint(next + 1));
       r.x += tBest * r.d;
       marchObject(next, r, cauchy);
       ended = r.done;
