@@ -65,9 +65,10 @@ struct SceneRenderer::Impl {
   gl::Program program;
   std::string program_key;  // the defines the program was built with
   // DISPERSION in two passes (draw): `program` traces green and marks in the depth buffer where it
-  // went through dispersive glass; `red_blue` traces red and blue there only (the depth test keeps
-  // the rest from being shaded). `single` does all three in one pass, for a target without depth
-  // (made when first needed).
+  // met dispersive glass; `red_blue` traces red and blue there only (the depth test keeps the rest
+  // from being shaded), or with N spectral bands all of them, the spectrum's ends traced and the
+  // bands between interpolated, green's ray having stopped at the glass (raymarch.frag). `single`
+  // traces red, green and blue in one pass, for a target without depth (made when first needed).
   bool two_pass = false;
   gl::Program red_blue, single;
   std::vector<RaymarchObject> shapes;  // of the last build, for `single`
@@ -567,9 +568,8 @@ void SceneRenderer::draw(const Camera& camera, glm::ivec2 size) {
     s.triangle.draw();
     return;
   }
-  // Green everywhere, its depth 0 where it went through dispersive glass and 1 elsewhere; then red
-  // and blue over a triangle at depth ½ that passes (GREATER) only where green wrote 0, into the
-  // red and blue channels alone.
+  // Green everywhere, its depth 0 where it met dispersive glass and 1 elsewhere; then red and blue,
+  // or the N bands, over a triangle at depth ½ that passes (GREATER) only where green wrote 0.
   s.setUniforms(s.program, camera, size);
   s.setUniforms(s.red_blue, camera, size);
   glEnable(GL_DEPTH_TEST);
@@ -579,7 +579,8 @@ void SceneRenderer::draw(const Camera& camera, glm::ivec2 size) {
   s.triangle.draw();
   glDepthFunc(GL_GREATER);
   glDepthMask(GL_FALSE);
-  // Three bands: red and blue here, green's from the first pass; N bands: every channel here.
+  // Three bands: red and blue here, green's from the first pass; N bands: every channel here (the
+  // first pass stopped green's ray where it met dispersive glass).
   glColorMask(GL_TRUE, s.settings.bands == 3 ? GL_FALSE : GL_TRUE, GL_TRUE, GL_FALSE);
   s.red_blue.use();
   s.triangle.draw();

@@ -793,6 +793,10 @@ void march@(inout Ray r, float cauchy) {
 #endif
   March@ m = enterVolume@(r, cauchy);
   markDispersed@(r, m.medium);
+  if (leftToTheBands(r)) {
+    r.done = true;
+    return;
+  }
   enterSharpFace@(r, m);
   int steps = 0;
   for (int pass = 0; pass < kMaxEventsPerObject && steps < uObjMaxSteps[@]; ++pass) {
@@ -828,6 +832,10 @@ void march@(inout Ray r, float cauchy) {
     recordWay(r, uint(event));
     recordWay(r, uint(m.medium + 2));
     recordWay(r, gSurfaceCode);
+    if (leftToTheBands(r)) {
+      r.done = true;
+      return;
+    }
     if (stop) break;
   }
   leaveVolume@(r, m);

@@ -175,6 +175,17 @@ uint surfaceCode(vec3 normal) {
   uvec3 level = uvec3(sign(normal) * step(1.0 / 3.0, abs(normal)) + 1.0);
   return 1u + level.x + 3u * level.y + 9u * level.z;
 }
+// The first of two passes (DISPERSION_GREEN_PASS) leaves a ray that meets dispersive glass to the
+// N bands' pass (DISPERSION_BANDS), which shades every channel of that pixel again: the ray stops
+// there, and its reflection is not traced. With three bands green's ray is the green channel.
+bool leftToTheBands(Ray r) {
+#if defined(DISPERSION_GREEN_PASS) && defined(DISPERSION_BANDS)
+  return r.dispersed;
+#else
+  return false;
+#endif
+}
+
 // Adds `code` to the ray's way (Ray.path): read only by DISPERSION_BANDS, nothing elsewhere.
 void recordWay(inout Ray r, uint code) {
 #ifdef DISPERSION_BANDS
@@ -287,7 +298,7 @@ void trace(inout Ray r, float cauchy, int skip) {
       last = next;
     }
 #ifdef REFLECT_OBJECTS
-    if (ended && !second && gRecordBranch && dot(gBranchWeight, vec3(1.0)) > 0.0) {
+    if (ended && !second && gRecordBranch && dot(gBranchWeight, vec3(1.0)) > 0.0 && !leftToTheBands(r)) {
       // Through: the reflection goes on from where it left, the primary ray waits.
       primary = r;
       second = true;
@@ -489,14 +500,15 @@ void main() {
   const vec3 lambda = vec3(0.61, 0.55, 0.465);
   vec3 cauchy = 1.0 / (lambda * lambda) - vec3(1.0 / (0.5876 * 0.5876));
 #if defined(DISPERSION_GREEN_PASS)
-  // Two passes (SceneRenderer::draw): green here, and in the depth buffer where it went through
-  // dispersive glass (0) or not (1); red and blue follow in a pass the depth test confines there.
+  // Two passes (SceneRenderer::draw): green here, and in the depth buffer where it met dispersive
+  // glass (0) or not (1); red and blue, or the N bands (green's ray then stopped at the glass:
+  // leftToTheBands), follow in a pass the depth test confines there.
   Shaded green = traceShaded(cauchy[1]);
   gl_FragDepth = green.r.dispersed ? 0.0 : 1.0;
   outColor = vec4(finishShaded(green), 1.0);
 #elif defined(DISPERSION_RED_BLUE_PASS) && defined(DISPERSION_BANDS)
-  // N spectral bands, as lightsim --bands bakes them (core/spectrum.h spectralBands): each at its
-  // own n(λ_b) and weighted by its share of R, G and B (the shares sum to 1 per channel), in every
+  // N spectral bands as lightsim --bands bakes them (core/spectrum.h spectralBands), each at its own
+  // n(λ_b) and weighted by its share of R, G and B (the shares sum to 1 per channel), in every
   // channel (SceneRenderer::draw unmasks green for this pass). Not every band is traced
   // (docs/physics.md "Dispersion in spectral bands"): the spectrum's two ends are, and where they
   // took one way through the glass (samePath) the bands between are interpolated (spectralRun).
