@@ -447,7 +447,8 @@ float bandFraction(int b) {
 // ended where it ends, on the ground's map or in the environment, as a traced ray is. What the ray
 // gathered on the way (reflections looked up inside the glass, emission, scattering) and the
 // reflection it recorded are interpolated as colours.
-vec3 spectralBand(Shaded a, Shaded b, vec3 gatheredA, vec3 gatheredB, float lodA, float lodB, float t) {
+vec3 spectralBand(Shaded a, Shaded b, vec3 gatheredA, vec3 gatheredB, vec3 branchA, vec3 branchB, float lodA,
+                  float lodB, float t) {
   Ray r = a.r;
   r.x = mix(a.r.x, b.r.x, t);
   r.d = normalize(mix(a.r.d, b.r.d, t));
@@ -457,7 +458,7 @@ vec3 spectralBand(Shaded a, Shaded b, vec3 gatheredA, vec3 gatheredB, float lodA
   r.groundWeight = mix(a.r.groundWeight, b.r.groundWeight, t);
   if (r.grounded) r.radiance += r.groundWeight * groundRadiance(r.x);
 #endif
-  return finishAt(r, mix(lodA, lodB, t)) + mix(branchColor(a), branchColor(b), t);
+  return finishAt(r, mix(lodA, lodB, t)) + mix(branchA, branchB, t);
 }
 
 // Bands i0 … i1 between a (traced at band i0) and b (traced at band ib ≥ i1), weighted by their
@@ -465,10 +466,12 @@ vec3 spectralBand(Shaded a, Shaded b, vec3 gatheredA, vec3 gatheredB, float lodA
 // detail between the two's.
 vec3 spectralRun(Shaded a, Shaded b, int i0, int i1, int ib, float lodA, float lodB) {
   vec3 gatheredA = gatheredOnTheWay(a.r), gatheredB = gatheredOnTheWay(b.r);
+  vec3 branchA = branchColor(a), branchB = branchColor(b);  // once, not once a band
   float c0 = uBandCauchy[i0], span = uBandCauchy[ib] - c0;
   vec3 color = vec3(0.0);
   for (int band = i0; band <= i1; ++band)
-    color += uBandRgb[band] * spectralBand(a, b, gatheredA, gatheredB, lodA, lodB, span != 0.0 ? (uBandCauchy[band] - c0) / span : 0.0);
+    color += uBandRgb[band] * spectralBand(a, b, gatheredA, gatheredB, branchA, branchB, lodA, lodB,
+                                           span != 0.0 ? (uBandCauchy[band] - c0) / span : 0.0);
   return color;
 }
 
